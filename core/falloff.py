@@ -1,0 +1,45 @@
+"""Light falloffs and the quad-to-spot projector distance (the talk's epilogue)."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import shading_ops as op
+
+#: Smallest distance used by the inverse-square law (1 cm, Lagarde & de Rousiers 2014, eq. 15).
+MIN_DISTANCE = 0.01
+#: Smallest denominator for the cone falloff and the projector distance.
+ANGLE_EPS = 1e-6
+
+
+def window_falloff(distance, radius):
+    """Windowing function saturate(1 - (d/r)^4)^2 (Karis 2013, eq. 9); 0 for radius <= 0."""
+    x = op.safe_div(distance, radius)
+    x2 = x * x
+    w = op.saturate(1.0 - x2 * x2)
+    return op.select(np.asarray(radius) > 0.0, w * w, 0.0)
+
+
+def inverse_square_falloff(distance, min_distance=MIN_DISTANCE):
+    """1 / max(d^2, d_min^2): the inverse-square law, clamped at 1 cm (Lagarde & de Rousiers 2014)."""
+    d2 = op.maximum(np.asarray(distance) ** 2, min_distance * min_distance)
+    return 1.0 / d2
+
+
+def cone_falloff(cos_to_axis, inner_angle, outer_angle):
+    """Spot cone falloff saturate((cos(a/2) - cos(phi/2)) / (cos(theta/2) - cos(phi/2))).
+
+    The talk's epilogue: theta = inner and phi = outer *full* cone angles (as Blender's
+    spot size), a/2 the angle between the spot axis and the direction to the point, so
+    ``cos_to_axis`` = cos(a/2).  inner >= outer gives a hard edge at the outer angle.
+    """
+    cos_outer = np.cos(0.5 * np.asarray(outer_angle))
+    cos_inner = np.cos(0.5 * np.minimum(inner_angle, outer_angle))
+    return op.saturate((cos_to_axis - cos_outer) / op.maximum(cos_inner - cos_outer, ANGLE_EPS))
+
+
+def projector_distance(diameter, outer_angle):
+    """Distance behind a quad light of the spot apex whose cone fits it: p = (d/2) / tan(phi/2).
+
+    The talk's quad-to-spot fallback; phi = outer full cone angle in (0, pi).
+    """
+    return 0.5 * np.asarray(diameter) / op.maximum(np.tan(0.5 * np.asarray(outer_angle)), ANGLE_EPS)

@@ -1,0 +1,143 @@
+"""Scalar and vector math with Blender shader-node semantics (numpy backend).
+
+Shading code in ``core`` is written with these functions so that the guard behind every
+division, square root, inverse trigonometric function and normalisation is explicit and
+identical wherever the math is evaluated: in numpy here, and in Blender node groups later
+(the node-group backend maps each function to one Math / Vector Math node).
+
+Blender's Math node differs between engines (Cycles ``kernel/svm/math_util.h`` vs EEVEE
+``gpu_shader_common_math.glsl``; see ../shared/reference/blender_addon.md §2.5 and ltc.md
+§5.1).  The functions below pick, for each operation, the behaviour that both engines
+share once the inputs are guarded, and the shading code supplies those guards:
+
+==================  ======================================  ==============================
+operation           Cycles                                  EEVEE
+==================  ======================================  ==============================
+a / b               0 when b == 0                           0 when b == 0
+sqrt(a)             sqrt(max(a, 0))                         a > 0 ? sqrt(a) : 0
+inversesqrt(a)      a > 0 ? 1/sqrt(a) : 0                   unguarded  -> callers pass max(a, eps)
+acos(a), asin(a)    input clamped to [-1, 1]                0 outside [-1, 1] -> callers clamp
+pow(a, b)           0 for a < 0 and fractional b            same
+log(a, base)        0 for a <= 0                            same
+normalize(v)        zero vector for |v| = 0                 same (5.0 GLSL checks length)
+==================  ======================================  ==============================
+
+All functions accept scalars or numpy arrays (float32 or float64) and broadcast; vectors
+are arrays whose last axis has length 3.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def _arr(x):
+    """Float array view of x: float32/float64 kept, Python numbers and integers become float64."""
+    a = np.asarray(x)
+    return a if a.dtype.kind == "f" else a.astype(np.float64)
+
+
+# --- scalar math -------------------------------------------------------------------------
+
+def safe_div(a, b):
+    """a / b with Blender's Divide semantics: 0 where b == 0."""
+    a, b = np.broadcast_arrays(_arr(a), _arr(b))
+    out = np.zeros(a.shape, dtype=np.result_type(a, b))
+    np.divide(a, b, out=out, where=(b != 0))
+    return out
+
+
+def sqrt(a):
+    """Square root with Blender semantics: 0 for a <= 0."""
+    return np.sqrt(np.maximum(_arr(a), 0.0))
+
+
+def inverse_sqrt(a, eps):
+    """1/sqrt(max(a, eps)); eps > 0 is required because EEVEE's inversesqrt is unguarded."""
+    if not eps > 0:
+        raise ValueError("inverse_sqrt needs an explicit eps > 0")
+    return 1.0 / np.sqrt(np.maximum(_arr(a), eps))
+
+
+def acos(a):
+    """arccos of the input clamped to [-1, 1] (the clamp is explicit in nodes too)."""
+    return np.arccos(np.clip(_arr(a), -1.0, 1.0))
+
+
+def asin(a):
+    """arcsin of the input clamped to [-1, 1]."""
+    return np.arcsin(np.clip(_arr(a), -1.0, 1.0))
+
+
+def exp(a):
+    return np.exp(_arr(a))
+
+
+def exp2(a):
+    """2**a (Blender: Power node with base 2)."""
+    return np.exp2(_arr(a))
+
+
+def log2(a):
+    """log2(a) with Blender's Logarithm semantics: 0 for a <= 0."""
+    a = _arr(a)
+    out = np.zeros(a.shape, dtype=a.dtype)
+    np.log2(a, out=out, where=(a > 0))
+    return out
+
+
+def pow5(a):
+    """a**5 by multiplication (no Power node, so no negative-base rule applies)."""
+    a = _arr(a)
+    a2 = a * a
+    return a2 * a2 * a
+
+
+def minimum(a, b):
+    return np.minimum(_arr(a), _arr(b))
+
+
+def maximum(a, b):
+    return np.maximum(_arr(a), _arr(b))
+
+
+def clamp(a, lo, hi):
+    return np.minimum(np.maximum(_arr(a), lo), hi)
+
+
+def saturate(a):
+    """Clamp to [0, 1] (the Math node's "Clamp" option)."""
+    return clamp(a, 0.0, 1.0)
+
+
+def mix(a, b, t):
+    """Linear interpolation a + (b - a) t (HLSL lerp, Blender Mix node)."""
+    a, b, t = _arr(a), _arr(b), _arr(t)
+    return a + (b - a) * t
+
+
+def select(condition, if_true, if_false):
+    """Per-element choice; in nodes a Compare/Greater Than result drives a Mix factor."""
+    return np.where(condition, _arr(if_true), _arr(if_false))
+
+
+# --- vector math (last axis = xyz) -------------------------------------------------------
+
+def dot(a, b):
+    return np.sum(_arr(a) * _arr(b), axis=-1)
+
+
+def cross(a, b):
+    return np.cross(_arr(a), _arr(b))
+
+
+def length(v):
+    return np.sqrt(dot(v, v))
+
+
+def normalize(v):
+    """v/|v|, and the zero vector for |v| == 0 (Blender's Vector Math Normalize)."""
+    v = _arr(v)
+    n = length(v)[..., None]
+    out = np.zeros(np.broadcast_shapes(v.shape, n.shape), dtype=v.dtype)
+    np.divide(v, n, out=out, where=(n > 0))
+    return out
