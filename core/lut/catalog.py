@@ -1,0 +1,154 @@
+"""What tables exist, their layout, and whether the files on disk are usable.
+
+docs/luts.md describes the same layouts for people; tests check the two agree.
+
+Axes.  u is always Blender roughness r, node i at r = i / (W - 1).  v is mu = cos(theta_view)
+for the energy tables (E is an even, smooth function of theta, so a mu-linear axis spends
+its nodes where E bends: near grazing at low roughness; measured in docs/luts.md), and
+sqrt(1 - mu) for the LTC tables (their matrix entries are odd in theta).
+Node i sits at the texel centre (i + 0.5) / W; a shader samples at
+    (x * (N - 1) + 0.5) / N
+with bilinear filtering and EXTEND, which reconstructs the piecewise-linear table exactly.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import exr_io
+
+#: Bumped when the meaning or layout of any table changes.
+LAYOUT_VERSION = 1
+
+AXIS_U_ROUGHNESS = "u: Blender roughness r (GGX alpha = max(r^2, 1e-4)); node i at r = i/(W-1), texel centre (i+0.5)/W"
+AXIS_V_MU = ("v: mu = cos(theta_view); node j at mu = j/(H-1), texel centre (j+0.5)/H "
+             "(Blender row j counted from the bottom)")
+
+
+@dataclass(frozen=True)
+class TableSpec:
+    name: str
+    filename: str
+    group: str
+    width: int
+    height: int
+    channels: str
+    description: str
+    axis_u: str = AXIS_U_ROUGHNESS
+    axis_v: str = AXIS_V_MU
+
+    @property
+    def shape(self):
+        return (self.height, self.width)
+
+
+@dataclass(frozen=True)
+class BakeGroup:
+    """Tables computed together from the same samples (so they are mutually consistent)."""
+    name: str
+    generator_version: int
+    params: dict = field(hash=False)
+    sources: tuple  # module files (relative to the package root) whose code defines the values
+
+
+ENERGY_SIZE = 64
+
+#: Hammersley points per table cell for the GGX energy tables.  A measured choice:
+#: scripts/benchmark_luts.py (docs/benchmarks/luts.md) gives the error against a 2^20-point
+#: reference for 2^10 .. 2^18.
+ENERGY_SAMPLES = 1 << 14
+
+GROUPS = {
+    "ggx_energy": BakeGroup(
+        name="ggx_energy",
+        generator_version=1,
+        params={"size": ENERGY_SIZE, "samples": ENERGY_SAMPLES, "sampler": "hammersley-2d+ggx-vndf",
+                "mu_min": 1e-4},
+        sources=("core/energy.py", "core/microfacet.py", "core/sampling.py", "core/conventions.py",
+                 "core/shading_ops.py", "core/lut/bake.py"),
+    ),
+}
+
+TABLES = {
+    spec.name: spec
+    for spec in (
+        TableSpec(
+            name="ggx_one_minus_E", filename="ggx_one_minus_E.exr", group="ggx_energy",
+            width=ENERGY_SIZE, height=ENERGY_SIZE,
+            channels="R = G = B = 1 - E(mu, r); A = 1",
+            description="1 - directional albedo of single-scattering GGX with F = 1 "
+                        "(height-correlated Smith G2); Kulla-Conty and Turquin input"),
+        TableSpec(
+            name="ggx_E_avg", filename="ggx_E_avg.exr", group="ggx_energy",
+            width=ENERGY_SIZE, height=1,
+            channels="R = G = B = E_avg(r); A = 1",
+            description="E_avg(r) = 2 int E(mu) mu dmu of the piecewise-linear E that ggx_one_minus_E "
+                        "reconstructs (exact furnace for the Kulla-Conty lobe)",
+            axis_v="v: none (one row; sample at v = 0.5)"),
+        TableSpec(
+            name="ggx_split_sum", filename="ggx_split_sum.exr", group="ggx_energy",
+            width=ENERGY_SIZE, height=ENERGY_SIZE,
+            channels="R = scale, G = bias (int f mu_l dl = F0 * scale + F90 * bias); B = 0; A = 1",
+            description="split-sum environment BRDF of single-scattering GGX (Karis 2013); "
+                        "scale + bias = E from the same samples"),
+    )
+}
+
+_PACKAGE_ROOT = Path(__file__).resolve().parents[2]
+
+
+def default_lut_dir():
+    """The ``luts/`` folder shipped with the extension."""
+    return _PACKAGE_ROOT / "luts"
+
+
+def inputs_hash(group_name):
+    """Hash of everything that determines a bake group's values: parameters and source code."""
+    group = GROUPS[group_name]
+    h = hashlib.sha256()
+    h.update(json.dumps({"layout": LAYOUT_VERSION, "group": group.name,
+                         "generator": group.generator_version, "params": group.params},
+                        sort_keys=True).encode())
+    for rel in group.sources:
+        h.update(rel.encode())
+        h.update((_PACKAGE_ROOT / rel).read_bytes())
+    return h.hexdigest()
+
+
+@dataclass(frozen=True)
+class LutStatus:
+    name: str
+    path: Path
+    state: str  # "ok", "missing", "stale", "corrupt" or "mismatch"
+    message: str
+
+
+def table_status(spec, lut_dir, expected_hash=None):
+    path = Path(lut_dir) / spec.filename
+    try:
+        _, meta = exr_io.read_table(path, expected_table=spec.name, expected_shape=spec.shape)
+    except exr_io.LutMissingError as exc:
+        return LutStatus(spec.name, path, "missing", str(exc))
+    except exr_io.LutCorruptError as exc:
+        return LutStatus(spec.name, path, "corrupt", str(exc))
+    except exr_io.LutMismatchError as exc:
+        return LutStatus(spec.name, path, "mismatch", str(exc))
+    if meta.get("layout_version") != LAYOUT_VERSION:
+        return LutStatus(spec.name, path, "mismatch",
+                         f"{path}: layout version {meta.get('layout_version')}, this code reads "
+                         f"{LAYOUT_VERSION}. Re-bake with `{exr_io.BAKE_COMMAND} --force`.")
+    expected_hash = expected_hash or inputs_hash(spec.group)
+    if meta.get("inputs_hash") != expected_hash:
+        return LutStatus(spec.name, path, "stale",
+                         f"{path}: baked from other inputs than the current code and settings. "
+                         f"Re-bake with `{exr_io.BAKE_COMMAND}`.")
+    return LutStatus(spec.name, path, "ok", f"{path.name}: ok")
+
+
+def lut_status(lut_dir=None):
+    """Status of every table in ``lut_dir`` (default: the shipped folder)."""
+    lut_dir = Path(lut_dir) if lut_dir is not None else default_lut_dir()
+    hashes = {g: inputs_hash(g) for g in GROUPS}
+    return [table_status(spec, lut_dir, hashes[spec.group]) for spec in TABLES.values()]

@@ -1,0 +1,123 @@
+"""A small OpenEXR reader for the LUT files this project writes, in pure Python + numpy.
+
+Blender's bundled Python has no ``OpenEXR`` module, so the add-on reads its tables with
+this when that import fails.  It supports exactly what ``exr_io.write_table`` produces and
+refuses anything else with a clear error: single-part scanline images, NO or ZIP(S)
+compression, FLOAT (32-bit) channels, x/y sampling 1.  Attributes of type string, int,
+float and double are decoded; others are kept as raw bytes.
+
+Format: OpenEXR file layout (openexr.com, "OpenEXR File Layout"): magic 20000630, version
+word, attributes (name\\0 type\\0 int32 size, value) ended by \\0, a uint64 offset per
+chunk, then chunks (int32 y, int32 size, data).  ZIP chunks hold 16 scanlines (ZIPS 1),
+deflated after a byte-delta predictor and an even/odd byte split; each scanline stores
+the channels in alphabetical order.
+"""
+from __future__ import annotations
+
+import struct
+import zlib
+
+import numpy as np
+
+MAGIC = 20000630
+_NO, _ZIPS, _ZIP = 0, 2, 3
+_LINES_PER_CHUNK = {_NO: 1, _ZIPS: 1, _ZIP: 16}
+_FLOAT = 2
+
+
+class ExrFormatError(ValueError):
+    pass
+
+
+def _cstring(data, pos):
+    end = data.index(b"\0", pos)
+    return data[pos:end].decode("latin-1"), end + 1
+
+
+def _parse_channels(value):
+    channels, pos = [], 0
+    while value[pos:pos + 1] != b"\0":
+        name, pos = _cstring(value, pos)
+        pixel_type, _p_linear, x_samp, y_samp = struct.unpack_from("<iB3xii", value, pos)
+        pos += 16
+        channels.append((name, pixel_type, x_samp, y_samp))
+    return channels
+
+
+def _decode_attribute(type_name, value):
+    if type_name == "string":
+        return value.decode("utf-8")
+    if type_name == "int":
+        return struct.unpack("<i", value)[0]
+    if type_name == "float":
+        return struct.unpack("<f", value)[0]
+    if type_name == "double":
+        return struct.unpack("<d", value)[0]
+    if type_name == "chlist":
+        return _parse_channels(value)
+    if type_name in ("compression", "lineOrder"):
+        return value[0]
+    if type_name == "box2i":
+        return struct.unpack("<4i", value)
+    return value
+
+
+def _unzip(data, expected):
+    raw = np.frombuffer(zlib.decompress(data), dtype=np.uint8)
+    if raw.size != expected:
+        raise ExrFormatError(f"chunk inflates to {raw.size} bytes, expected {expected}")
+    # undo the predictor: t[i] = t[i-1] + raw[i] - 128 (mod 256)
+    t = (np.cumsum(np.concatenate([[raw[0]], raw[1:].astype(np.int64) - 128])) & 0xFF).astype(np.uint8)
+    half = (raw.size + 1) // 2
+    out = np.empty(raw.size, dtype=np.uint8)
+    out[0::2] = t[:half]
+    out[1::2] = t[half:]
+    return out.tobytes()
+
+
+def read(path):
+    """Return (attributes dict, {channel name: (H, W) float32 array, top row first})."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if len(data) < 8 or struct.unpack_from("<i", data, 0)[0] != MAGIC:
+        raise ExrFormatError("not an OpenEXR file (bad magic number)")
+    version = struct.unpack_from("<i", data, 4)[0]
+    if version & 0xFF != 2 or version & 0x1A00:   # tiled / multi-part / deep bits
+        raise ExrFormatError(f"unsupported EXR flavour (version word {version:#x})")
+    pos, attrs, types = 8, {}, {}
+    while data[pos:pos + 1] != b"\0":
+        name, pos = _cstring(data, pos)
+        type_name, pos = _cstring(data, pos)
+        size = struct.unpack_from("<i", data, pos)[0]
+        pos += 4
+        attrs[name] = _decode_attribute(type_name, data[pos:pos + size])
+        types[name] = type_name
+        pos += size
+    pos += 1
+    compression = attrs.get("compression")
+    if compression not in _LINES_PER_CHUNK:
+        raise ExrFormatError(f"unsupported compression {compression}")
+    x0, y0, x1, y1 = attrs["dataWindow"]
+    width, height = x1 - x0 + 1, y1 - y0 + 1
+    channels = sorted(attrs["channels"])
+    for name, pixel_type, xs, ys in channels:
+        if pixel_type != _FLOAT or xs != 1 or ys != 1:
+            raise ExrFormatError(f"channel {name}: only unsubsampled 32-bit float is supported")
+    lines = _LINES_PER_CHUNK[compression]
+    n_chunks = (height + lines - 1) // lines
+    offsets = struct.unpack_from(f"<{n_chunks}Q", data, pos)
+    planes = {name: np.empty((height, width), dtype="<f4") for name, *_ in channels}
+    for offset in offsets:
+        y, size = struct.unpack_from("<ii", data, offset)
+        chunk = data[offset + 8:offset + 8 + size]
+        rows = min(lines, y1 + 1 - y)
+        expected = rows * width * 4 * len(channels)
+        if compression != _NO and size < expected:
+            chunk = _unzip(chunk, expected)
+        if len(chunk) != expected:
+            raise ExrFormatError(f"chunk at line {y}: {len(chunk)} bytes, expected {expected}")
+        block = np.frombuffer(chunk, dtype="<f4").reshape(rows, len(channels), width)
+        for c, (name, *_) in enumerate(channels):
+            planes[name][y - y0:y - y0 + rows] = block[:, c]
+    attrs["channels"] = [name for name, *_ in channels]
+    return attrs, planes

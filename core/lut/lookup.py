@@ -1,0 +1,71 @@
+"""Sampling LUTs the way Blender's Image Texture node does, and the energy tables as functions.
+
+``sample_bilinear`` reproduces Cycles' Linear interpolation with EXTEND: texel i has its
+centre at u = (i + 0.5)/W, and coordinates outside the centres clamp to the edge texels
+(../shared/reference/blender_addon.md §3.2).  ``lut_coordinate`` maps a table parameter in
+[0, 1] onto the texel centres, so node values are returned exactly and the table is
+reconstructed as a piecewise-linear function of its parameters.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .. import shading_ops as op
+from . import catalog, exr_io
+
+
+def lut_coordinate(x, size):
+    """Texture coordinate of table parameter x in [0, 1]: (x (N - 1) + 0.5) / N."""
+    return (op.saturate(x) * (size - 1) + 0.5) / size
+
+
+def energy_lut_uv(mu, roughness, size=catalog.ENERGY_SIZE):
+    """(u, v) of the energy tables: u from roughness, v from mu."""
+    return lut_coordinate(roughness, size), lut_coordinate(mu, size)
+
+
+def sample_bilinear(table, u, v):
+    """Bilinear lookup of a (H, W, C) table at texture coordinates (u, v), EXTEND at the edges."""
+    table = np.asarray(table)
+    h, w = table.shape[:2]
+    x = np.clip(np.asarray(u, dtype=np.float64) * w - 0.5, 0.0, w - 1)
+    y = np.clip(np.asarray(v, dtype=np.float64) * h - 0.5, 0.0, h - 1)
+    x0 = np.minimum(np.floor(x).astype(np.int64), w - 2) if w > 1 else np.zeros(x.shape, np.int64)
+    y0 = np.minimum(np.floor(y).astype(np.int64), h - 2) if h > 1 else np.zeros(y.shape, np.int64)
+    fx = (x - x0)[..., None]
+    fy = (y - y0)[..., None]
+    x1 = np.minimum(x0 + 1, w - 1)
+    y1 = np.minimum(y0 + 1, h - 1)
+    top = table[y0, x0] * (1.0 - fx) + table[y0, x1] * fx
+    bottom = table[y1, x0] * (1.0 - fx) + table[y1, x1] * fx
+    return top * (1.0 - fy) + bottom * fy
+
+
+class EnergyTables:
+    """The GGX energy tables of one LUT folder, sampled as Blender samples them."""
+
+    def __init__(self, lut_dir=None):
+        lut_dir = Path(lut_dir) if lut_dir is not None else catalog.default_lut_dir()
+        self.tables = {}
+        for name in ("ggx_one_minus_E", "ggx_E_avg", "ggx_split_sum"):
+            spec = catalog.TABLES[name]
+            self.tables[name], _ = exr_io.read_table(lut_dir / spec.filename, spec.name, spec.shape)
+
+    def one_minus_e(self, mu, roughness):
+        u, v = energy_lut_uv(mu, roughness)
+        return sample_bilinear(self.tables["ggx_one_minus_E"], u, v)[..., 0]
+
+    def e(self, mu, roughness):
+        return 1.0 - self.one_minus_e(mu, roughness)
+
+    def e_avg(self, roughness):
+        u = lut_coordinate(roughness, catalog.ENERGY_SIZE)
+        return sample_bilinear(self.tables["ggx_E_avg"], u, np.full(np.shape(u), 0.5))[..., 0]
+
+    def split_sum(self, mu, roughness):
+        """(scale, bias) at (mu, r)."""
+        u, v = energy_lut_uv(mu, roughness)
+        rg = sample_bilinear(self.tables["ggx_split_sum"], u, v)
+        return rg[..., 0], rg[..., 1]
