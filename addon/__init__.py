@@ -1,0 +1,25 @@
+"""The bpy layer of RT Lookdev: operators, preferences and UI.
+
+Everything that touches ``bpy`` lives here; the numeric work is in ``..core``.  Each
+submodule defines its classes, and this module registers them in one ``classes``
+tuple (in order) and unregisters them in reverse.  Registration does no file I/O.
+"""
+import bpy
+
+from . import operators, preferences
+
+classes = (
+    *operators.classes,
+    *preferences.classes,
+)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
+    preferences.clear_status_cache()

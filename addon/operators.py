@@ -1,0 +1,80 @@
+"""Operators of RT Lookdev (``bpy.ops.rtl.*``)."""
+from __future__ import annotations
+
+import bpy
+
+from . import preferences
+
+#: States that make the tables unusable: the operator fails on these.
+ERROR_STATES = ("corrupt", "mismatch")
+#: States that mean "bake again": the operator warns on these.
+WARNING_STATES = ("missing", "stale")
+
+BAKE_HINT = "bake them with `python scripts/bake_luts.py` or set another LUT directory in the preferences"
+
+
+def _summarise(statuses, states):
+    """``"corrupt: a, b; mismatch: c"`` for the tables in ``states``."""
+    parts = []
+    for state in states:
+        names = [s.name for s in statuses if s.state == state]
+        if names:
+            parts.append(f"{state}: {', '.join(names)}")
+    return "; ".join(parts)
+
+
+class RTL_OT_lut_status(bpy.types.Operator):
+    """Check that the baked lookup tables exist and match the current code"""
+
+    bl_idname = "rtl.lut_status"
+    bl_label = "Check LUT Status"
+    bl_options = {'REGISTER'}
+
+    @classmethod
+    def poll(cls, context):
+        lut_dir = preferences.lut_directory(context)
+        if not lut_dir.is_dir():
+            cls.poll_message_set(f"LUT directory does not exist: {lut_dir}")
+            return False
+        return True
+
+    def execute(self, context):
+        lut_dir = preferences.lut_directory(context)
+        try:
+            statuses = preferences.refresh_status(lut_dir)
+        except Exception as ex:
+            self.report({'ERROR'}, f"Could not check LUTs in {lut_dir}: {ex}")
+            return {'CANCELLED'}
+
+        if not statuses:
+            self.report({'WARNING'}, f"No LUT tables are defined (checked {lut_dir})")
+            return {'FINISHED'}
+
+        unknown = [s for s in statuses if s.state not in ("ok", *ERROR_STATES, *WARNING_STATES)]
+        if unknown:
+            self.report({'ERROR'}, "Unknown LUT state: " + ", ".join(f"{s.name}={s.state!r}" for s in unknown))
+            return {'CANCELLED'}
+
+        errors = [s for s in statuses if s.state in ERROR_STATES]
+        if errors:
+            # Full per-table messages go to the console; the report stays one line.
+            for status in statuses:
+                if status.state != "ok":
+                    print(f"RT Lookdev: LUT {status.name} is {status.state}: {status.message}")
+            message = f"Unusable LUT tables in {lut_dir} ({_summarise(statuses, ERROR_STATES)})"
+            warnings = _summarise(statuses, WARNING_STATES)
+            if warnings:
+                message += f", also {warnings}"
+            self.report({'ERROR'}, f"{message}: {errors[0].message}")
+            return {'CANCELLED'}
+
+        warnings = _summarise(statuses, WARNING_STATES)
+        if warnings:
+            self.report({'WARNING'}, f"LUT tables need baking in {lut_dir} ({warnings}); {BAKE_HINT}")
+            return {'FINISHED'}
+
+        self.report({'INFO'}, f"All {len(statuses)} LUT tables are up to date in {lut_dir}")
+        return {'FINISHED'}
+
+
+classes = (RTL_OT_lut_status,)

@@ -1,0 +1,103 @@
+"""Add-on preferences: where the LUT tables are read from, and their status."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import bpy
+from bpy.props import StringProperty
+
+from ..core.lut import catalog
+
+#: The extension's top-level package: ``bl_ext.<repo>.rt_lookdev`` when Blender loads
+#: the extension, ``rt_lookdev`` when tests load the source tree.  Add-on preferences
+#: are keyed by this name (``context.preferences.addons[ADDON_PACKAGE]``).  This
+#: module's ``__package__`` is ``<root>.addon``, so drop the last component.
+ADDON_PACKAGE = __package__.rpartition(".")[0]
+
+#: Icons shown next to each table in the preferences, by ``LutStatus.state``.
+STATE_ICONS = {
+    "ok": 'CHECKMARK',
+    "missing": 'ERROR',
+    "stale": 'TIME',
+    "corrupt": 'CANCEL',
+    "mismatch": 'CANCEL',
+}
+
+# Last status per LUT directory (str path -> list[LutStatus]).  Filled lazily by
+# draw() and refreshed by RTL_OT_lut_status, so redraws do not re-read the tables.
+_status_cache: dict[str, list] = {}
+
+
+def get_preferences(context=None):
+    """The add-on's preferences, or None when it was registered without addon_utils."""
+    context = context or bpy.context
+    addon = context.preferences.addons.get(ADDON_PACKAGE)
+    return addon.preferences if addon is not None else None
+
+
+def lut_directory(context=None) -> Path:
+    """The directory to read LUTs from: the preference if set, else the shipped ``luts/``."""
+    prefs = get_preferences(context)
+    custom = prefs.lut_directory.strip() if prefs is not None else ""
+    if custom:
+        return Path(bpy.path.abspath(custom))
+    return catalog.default_lut_dir()
+
+
+def refresh_status(lut_dir: Path) -> list:
+    """Check every table in ``lut_dir`` and remember the result for draw()."""
+    statuses = list(catalog.lut_status(lut_dir))
+    _status_cache[str(lut_dir)] = statuses
+    return statuses
+
+
+def cached_status(lut_dir: Path) -> list:
+    statuses = _status_cache.get(str(lut_dir))
+    if statuses is None:
+        statuses = refresh_status(lut_dir)
+    return statuses
+
+
+def clear_status_cache():
+    _status_cache.clear()
+
+
+class RTL_AddonPreferences(bpy.types.AddonPreferences):
+    bl_idname = ADDON_PACKAGE
+
+    lut_directory: StringProperty(
+        name="LUT Directory",
+        description=(
+            "Folder holding the baked lookup-table EXR files. "
+            "Leave empty to use the tables shipped with the add-on"
+        ),
+        subtype='DIR_PATH',
+        default="",
+    )
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "lut_directory")
+
+        lut_dir = lut_directory(context)
+        box = layout.box()
+        box.label(text=f"Tables in {lut_dir}", icon='FILE_FOLDER')
+        if not lut_dir.is_dir():
+            box.label(text="Directory does not exist", icon='ERROR')
+        else:
+            try:
+                statuses = cached_status(lut_dir)
+            except Exception as ex:  # show, never break the preferences panel
+                box.label(text=f"Could not check tables: {ex}", icon='ERROR')
+            else:
+                col = box.column(align=True)
+                for status in statuses:
+                    row = col.row()
+                    row.label(text=status.name, icon=STATE_ICONS.get(status.state, 'QUESTION'))
+                    row.label(text=status.state)
+                    if status.state != "ok" and status.message:
+                        col.label(text=f"    {status.message}")
+        layout.operator("rtl.lut_status", icon='FILE_REFRESH')
+
+
+classes = (RTL_AddonPreferences,)

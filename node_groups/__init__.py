@@ -1,0 +1,1 @@
+"""Shader node groups of RT Lookdev (built from the numpy core's descriptions)."""

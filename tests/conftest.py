@@ -1,0 +1,40 @@
+"""Shared pytest setup.
+
+- ``scripts/`` goes on sys.path and ``_bootstrap`` loads the repository as ``rt_lookdev``.
+- ``BLENDER_USER_RESOURCES`` points at a throw-away directory before anything can
+  import bpy, so tests never read or write the developer's ~/.config/blender.
+- ``blender`` marker for tests that need the bpy module; fixtures ``bpy_module``
+  (imports bpy once per session: it must never be re-imported) and ``empty_scene``.
+"""
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+SCRIPTS_DIR = Path(__file__).resolve().parents[1] / "scripts"
+sys.path.insert(0, str(SCRIPTS_DIR))
+
+import _bootstrap  # noqa: E402  (loads the package as ``rt_lookdev``)
+
+_USER_RESOURCES = tempfile.TemporaryDirectory(prefix="rtl-blender-user-")
+os.environ["BLENDER_USER_RESOURCES"] = _USER_RESOURCES.name
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "blender: needs the bpy module (Blender as a Python module)")
+
+
+@pytest.fixture(scope="session")
+def bpy_module():
+    import bpy
+
+    return bpy
+
+
+@pytest.fixture
+def empty_scene(bpy_module):
+    """Empty the open file (keeps preferences and enabled extensions)."""
+    bpy_module.ops.wm.read_homefile(use_empty=True)
+    return bpy_module.context.scene
