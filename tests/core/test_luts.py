@@ -1,0 +1,167 @@
+import sys
+from pathlib import Path
+
+import numpy as np
+import OpenEXR
+import pytest
+
+from rt_lookdev.core.lut import bake, catalog, exr_io, exr_reader, lookup
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _random_table(h=5, w=7, seed=0):
+    rng = np.random.default_rng(seed)
+    t = (rng.normal(size=(h, w, 4)) * 10.0 ** rng.integers(-30, 30, (h, w, 4))).astype(np.float32)
+    t[0, 0] = [0.0, -0.0, np.finfo(np.float32).tiny, np.finfo(np.float32).max]
+    return t
+
+
+def test_exr_round_trip_is_bit_exact(tmp_path):
+    table = _random_table()
+    exr_io.write_table(tmp_path / "t.exr", table, {"table": "test", "samples": 3})
+    back, meta = exr_io.read_table(tmp_path / "t.exr", "test", (5, 7))
+    assert back.dtype == np.float32 and back.tobytes() == table.tobytes()
+    assert meta["samples"] == 3 and meta["content_hash"] == exr_io.content_hash(table)
+
+
+def test_builtin_reader_matches_openexr(tmp_path, lut_dir):
+    files = [tmp_path / "random.exr"] + sorted(Path(lut_dir).glob("*.exr"))
+    exr_io.write_table(files[0], _random_table(40, 9, 1), {"table": "random", "f": 0.25})
+    for path in files:
+        attrs, planes = exr_reader.read(path)
+        with OpenEXR.File(str(path), separate_channels=True) as f:
+            header = dict(f.header())
+            channels = {n: np.array(c.pixels) for n, c in f.channels().items()}
+        assert set(planes) == set(channels)
+        for name, pixels in channels.items():
+            assert planes[name].tobytes() == pixels.astype("<f4").tobytes()
+        rtl = {k: v for k, v in header.items() if k.startswith("rtl.")}
+        assert rtl and all(attrs[k] == v for k, v in rtl.items())
+
+
+def test_read_table_without_openexr_module(monkeypatch, lut_dir):
+    spec = catalog.TABLES["ggx_split_sum"]
+    with_module, _ = exr_io.read_table(Path(lut_dir) / spec.filename, spec.name, spec.shape)
+    monkeypatch.setitem(sys.modules, "OpenEXR", None)   # import now raises ImportError, as in Blender
+    without, meta = exr_io.read_table(Path(lut_dir) / spec.filename, spec.name, spec.shape)
+    assert without.tobytes() == with_module.tobytes() and meta["table"] == spec.name
+
+
+def test_file_orientation_is_blender_bottom_up(tmp_path):
+    table = np.zeros((3, 2, 4), np.float32)
+    table[0, :, 0] = 1.0                      # table row 0 = v node 0 = bottom of the image
+    exr_io.write_table(tmp_path / "o.exr", table, {"table": "o"})
+    with OpenEXR.File(str(tmp_path / "o.exr"), separate_channels=True) as f:
+        red = np.array(f.channels()["R"].pixels)
+    assert np.all(red[-1] == 1.0) and np.all(red[:-1] == 0.0)   # EXR stores the top row first
+
+
+def test_missing_corrupt_and_mismatched_files(tmp_path, lut_dir):
+    spec = catalog.TABLES["ggx_one_minus_E"]
+    with pytest.raises(exr_io.LutMissingError, match="bake_luts.py"):
+        exr_io.read_table(tmp_path / "nope.exr", spec.name, spec.shape)
+    garbage = tmp_path / "garbage.exr"
+    garbage.write_bytes(b"not an exr at all")
+    with pytest.raises(exr_io.LutCorruptError, match="--force"):
+        exr_io.read_table(garbage, spec.name, spec.shape)
+    truncated = tmp_path / "truncated.exr"
+    truncated.write_bytes((Path(lut_dir) / spec.filename).read_bytes()[:600])
+    with pytest.raises(exr_io.LutCorruptError):
+        exr_io.read_table(truncated, spec.name, spec.shape)
+    with pytest.raises(exr_io.LutMismatchError, match="ggx_E_avg"):
+        exr_io.read_table(Path(lut_dir) / "ggx_E_avg.exr", spec.name, spec.shape)
+    with pytest.raises(exr_io.LutMismatchError, match="64x64"):
+        exr_io.read_table(Path(lut_dir) / spec.filename, spec.name, (32, 32))
+    foreign = tmp_path / "foreign.exr"
+    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION}, {"R": np.zeros((2, 2), np.float32)}) as f:
+        f.write(str(foreign))
+    with pytest.raises(exr_io.LutMismatchError, match="not an RT Lookdev LUT"):
+        exr_io.read_table(foreign, spec.name, spec.shape)
+
+
+def test_edited_pixels_fail_the_content_hash(tmp_path, lut_dir):
+    src = Path(lut_dir) / "ggx_split_sum.exr"
+    with OpenEXR.File(str(src), separate_channels=True) as f:
+        header = dict(f.header())
+        channels = {n: np.array(c.pixels) for n, c in f.channels().items()}
+    channels["G"][10, 10] += 1e-3
+    header = {k: v for k, v in header.items() if k.startswith("rtl.") or k == "compression"}
+    with OpenEXR.File(header, channels) as f:
+        f.write(str(tmp_path / "edited.exr"))
+    with pytest.raises(exr_io.LutCorruptError, match="content hash"):
+        exr_io.read_table(tmp_path / "edited.exr", "ggx_split_sum", (64, 64))
+
+
+def test_write_refuses_non_finite(tmp_path):
+    t = np.zeros((2, 2, 4), np.float32)
+    t[1, 1, 2] = np.nan
+    with pytest.raises(ValueError, match="non-finite"):
+        exr_io.write_table(tmp_path / "n.exr", t, {"table": "n"})
+    assert not (tmp_path / "n.exr").exists()
+
+
+@pytest.fixture
+def fast_energy_group(monkeypatch):
+    """The energy group with 16 samples per cell: same code path, a fraction of a second."""
+    group = catalog.GROUPS["ggx_energy"]
+    fast = catalog.BakeGroup(group.name, group.generator_version, dict(group.params, samples=16), group.sources)
+    monkeypatch.setitem(catalog.GROUPS, "ggx_energy", fast)
+    return fast
+
+
+def test_bake_cache_hit_and_miss(tmp_path, fast_energy_group, monkeypatch):
+    lines = []
+    first = bake.bake(tmp_path, log=lines.append)
+    assert [r.state for r in first] == ["baked"]
+    mtimes = {p: p.stat().st_mtime_ns for p in tmp_path.glob("*.exr")}
+    assert len(mtimes) == 3
+    second = bake.bake(tmp_path, log=lines.append)
+    assert [r.state for r in second] == ["cached"] and "nothing to do" in lines[-1]
+    assert {p: p.stat().st_mtime_ns for p in tmp_path.glob("*.exr")} == mtimes
+    assert all(s.state == "ok" for s in catalog.lut_status(tmp_path))
+    # a changed input makes the files stale and the next bake redoes them
+    changed = catalog.BakeGroup("ggx_energy", 1, dict(fast_energy_group.params, samples=32), fast_energy_group.sources)
+    monkeypatch.setitem(catalog.GROUPS, "ggx_energy", changed)
+    assert {s.state for s in catalog.lut_status(tmp_path)} == {"stale"}
+    assert [r.state for r in bake.bake(tmp_path, log=lines.append)] == ["baked"]
+    # a damaged file is re-baked too
+    (tmp_path / "ggx_E_avg.exr").write_bytes(b"junk")
+    assert catalog.table_status(catalog.TABLES["ggx_E_avg"], tmp_path).state == "corrupt"
+    assert [r.state for r in bake.bake(tmp_path, log=lines.append)] == ["baked"]
+
+
+def test_bake_is_deterministic(fast_energy_group):
+    a = bake.compute_energy_tables(16, 64)
+    b = bake.compute_energy_tables(16, 64)
+    assert all(a[k].tobytes() == b[k].tobytes() for k in a)
+
+
+def test_shipped_luts_are_current():
+    status = catalog.lut_status(catalog.default_lut_dir())
+    assert [s.state for s in status] == ["ok"] * len(catalog.TABLES), [s.message for s in status]
+
+
+def test_docs_describe_every_table():
+    doc = (REPO / "docs" / "luts.md").read_text()
+    for spec in catalog.TABLES.values():
+        assert spec.filename in doc and spec.channels in doc, spec.name
+
+
+def test_bilinear_sampling_reconstructs_nodes_and_extends():
+    table = np.arange(4 * 3 * 4, dtype=np.float64).reshape(4, 3, 4)
+    j, i = np.meshgrid(np.arange(4), np.arange(3), indexing="ij")
+    got = lookup.sample_bilinear(table, (i + 0.5) / 3, (j + 0.5) / 4)
+    assert np.array_equal(got, table)
+    assert np.array_equal(lookup.sample_bilinear(table, -1.0, 2.0), table[3, 0])       # EXTEND
+    mid = lookup.sample_bilinear(table, 1.0 / 3, 0.5 / 4)                                 # halfway in u
+    assert np.allclose(mid, 0.5 * (table[0, 0] + table[0, 1]))
+    x = np.linspace(0, 1, 7)
+    assert np.allclose(lookup.lut_coordinate(x, 64) * 64 - 0.5, x * 63)
+
+
+def test_energy_lut_matches_cycles_nodes(energy_tables):
+    from rt_lookdev.core import validation
+    result = validation.cycles_table_comparison(energy_tables)
+    assert result["max_abs_diff_E_lut"] < 1e-3 and result["max_abs_diff_E_avg_lut"] < 1e-3
+    assert result["E_avg_r1_lut"] == pytest.approx(0.409, abs=1e-3)
