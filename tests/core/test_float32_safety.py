@@ -1,0 +1,47 @@
+"""Every evaluation function stays finite and float32 at extreme float32 inputs."""
+import numpy as np
+import pytest
+
+from rt_lookdev.core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter
+
+F = np.float32
+COS = np.array([-1.0, -1e-7, 0.0, 1e-7, 0.5, 1.0 - 1e-7, 1.0], dtype=F)
+UNIT = np.array([0.0, 1e-7, 1e-4, 0.5, 1.0 - 1e-7, 1.0], dtype=F)
+
+
+def grid(*axes):
+    return np.meshgrid(*axes, indexing="ij")
+
+
+CASES = {
+    "ggx_brdf": lambda: microfacet.ggx_brdf(*grid(COS, COS, COS, COS, UNIT)),
+    "fresnel_schlick": lambda: fresnel.fresnel_schlick(*grid(UNIT, COS)),
+    "kulla_conty_brdf": lambda: multiscatter.kulla_conty_brdf(*grid(UNIT, UNIT, UNIT, UNIT)),
+    "turquin_compensation": lambda: multiscatter.turquin_compensation(*grid(UNIT, UNIT)),
+    "fdez_aguera_env_brdf": lambda: multiscatter.fdez_aguera_env_brdf(*grid(UNIT, UNIT, UNIT)),
+    "cod_multiscatter_diffuse": lambda: diffuse.cod_multiscatter_diffuse(F(0.8), *grid(COS, COS, COS, COS, UNIT)),
+    "cod_gloss_from_alpha": lambda: diffuse.cod_gloss_from_alpha(UNIT),
+    "wrapped_diffuse_cosine": lambda: diffuse.wrapped_diffuse_cosine(*grid(COS, UNIT)),
+    "ashikhmin_cloth_brdf": lambda: cloth.ashikhmin_cloth_brdf(*grid(COS, COS, COS, UNIT)),
+    "disney_sheen": lambda: cloth.disney_sheen(COS),
+    "window_falloff": lambda: falloff.window_falloff(*grid(UNIT * F(10), UNIT * F(10))),
+    "inverse_square_falloff": lambda: falloff.inverse_square_falloff(UNIT),
+    "cone_falloff": lambda: falloff.cone_falloff(*grid(COS, UNIT * F(3.1), UNIT * F(3.1))),
+    "projector_distance": lambda: falloff.projector_distance(*grid(UNIT, UNIT * F(3.1))),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_finite_and_float32(name):
+    with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):  # exp(-big) -> 0 is fine
+        value = CASES[name]()
+    assert value.dtype == np.float32, value.dtype
+    assert np.all(np.isfinite(value))
+
+
+def test_wrapped_normal_float32_degenerate():
+    n = np.array([[0, 0, 1]] * 3, dtype=F)
+    l = np.array([[0, 0, -1], [0, 0, 1], [1, 0, 0]], dtype=F)
+    with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+        out = diffuse.wrapped_normal(n, l, np.array([1.0, 1.0, 0.5], dtype=F))
+    assert out.dtype == np.float32 and np.allclose(np.linalg.norm(out, axis=-1), 1.0)
