@@ -1,0 +1,86 @@
+"""Horizon-clipped form factor of a spherical cap, and its table (the LTC "sphere table").
+
+The clipless LTC evaluation (Hill & Heitz 2016/2017; ltc.md §1.5) replaces a polygon or a
+disk by the spherical cap with the same vector form factor F: |F| = sin^2(sigma) (sigma =
+cap half-angle) and the cap axis along F.  The light's horizon-clipped form factor is then
+approximated by the cap's, which is known in closed form (Snyder 1996).
+
+Table layout (stored in the spare channel A of every ``*_mag`` LTC table): ``table[j, i]``
+with the z axis along i (texture u) and the |F| axis along j (texture v):
+    z = 2 i/(N - 1) - 1 (cosine of the cap axis elevation), len = j/(N - 1) (= |F|),
+    value = clipped_form_factor(z, len) / len in [0, 1], and max(z, 0) at len = 0.
+A shader reads it at u = lut_coordinate(z/2 + 1/2), v = lut_coordinate(|F|) and multiplies
+by |F| (``clipped_sphere_integral``).
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from .. import shading_ops as op
+from ..lut.lookup import lut_coordinate, sample_bilinear
+
+#: Default table size (64 x 64, the LTC tables' size, ltc.md §5.2).
+SIZE = 64
+
+
+# Snyder 1996, "Area light sources for real-time graphics" (Microsoft Research TR-96-11),
+# projected solid angle I_hemi(omega, sigma) of a cap of half-angle sigma whose axis makes the
+# angle omega with the normal, clipped by the horizon, written with its functions G and H.
+# Rewritten here in z = cos(omega), len = sin^2(sigma), c = cos(sigma), q = sqrt(len - z^2);
+# with sin(gamma) = c / sin(omega) and cos(gamma) = q / sin(omega), Snyder's
+#   omega <  pi/2:  pi z len + G - H,    omega >= pi/2:  G + H
+# collapse to one expression (H is odd in z, G even):
+#   I = pi max(z, 0) len + pi/2 - atan2(c, q) - c q - |z| len atan2(q, |z| c)
+# for z^2 < len (the cap straddles the horizon); I = pi max(z, 0) len otherwise.
+def cap_projected_solid_angle(z, length):
+    """Projected solid angle of the horizon-clipped cap (Snyder 1996 I_hemi), in [0, pi]."""
+    z = op.clamp(z, -1.0, 1.0)
+    length = op.saturate(length)
+    c = op.sqrt(1.0 - length)
+    q = op.sqrt(length - z * z)
+    az = np.abs(z)
+    straddling = (0.5 * np.pi - np.arctan2(c, q) - c * q - az * length * np.arctan2(q, az * c))
+    unclipped = np.pi * op.maximum(z, 0.0) * length
+    return unclipped + op.select(z * z < length, straddling, 0.0)
+
+
+def cap_form_factor(z, length):
+    """Horizon-clipped form factor of the cap: I_hemi / pi (Snyder 1996), in [0, 1]."""
+    return cap_projected_solid_angle(z, length) / np.pi
+
+
+def cap_form_factor_ratio(z, length):
+    """Clipped over unclipped form factor, clipped / |F| in [0, 1]; max(z, 0) at |F| = 0."""
+    return op.select(op.saturate(length) > 0.0, op.saturate(op.safe_div(cap_form_factor(z, length), length)),
+                     op.maximum(op.clamp(z, -1.0, 1.0), 0.0))
+
+
+def sphere_horizon_table(size=SIZE):
+    """(size, size) table[j, i] = ratio at z = 2 i/(N-1) - 1 (u axis), |F| = j/(N-1) (v axis)."""
+    t = np.arange(size, dtype=np.float64) / (size - 1)
+    z = 2.0 * t - 1.0
+    return cap_form_factor_ratio(z[None, :], t[:, None])
+
+
+@functools.lru_cache(maxsize=4)
+def default_table(size=SIZE):
+    """The table, built once per size (read-only)."""
+    table = sphere_horizon_table(size)
+    table.setflags(write=False)
+    return table
+
+
+# Hill & Heitz 2016/2017 (ltc_code ``ltc_quad.fs``, ltc.md §1.5): clipped integral of a light with
+# vector form factor F ~ |F| * table(z/2 + 1/2, |F|), z = F.z / |F|, bilinear at texel centres.
+def clipped_sphere_integral(length, z, table=None):
+    """|F| times the table's ratio at (z, |F|): the horizon-clipped form factor of the equivalent cap."""
+    length, z = np.asarray(length), np.asarray(z)
+    dtype = np.result_type(length.dtype, z.dtype, np.float32)
+    table = default_table() if table is None else np.asarray(table)
+    size_v, size_u = table.shape[:2]
+    u = lut_coordinate(z * 0.5 + 0.5, size_u)
+    v = lut_coordinate(length, size_v)
+    ratio = sample_bilinear(table.reshape(size_v, size_u, 1), u, v)[..., 0]
+    return (length * ratio).astype(dtype, copy=False)
