@@ -7,6 +7,7 @@ fixed low-discrepancy point sets, so the same inputs give the same tables.
 """
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -52,7 +53,39 @@ def compute_energy_tables(size, n_samples, progress=None):
     }
 
 
-_COMPUTE = {"ggx_energy": lambda p, progress: compute_energy_tables(p["size"], p["samples"], progress)}
+def compute_ltc_tables(prefix, params, progress=None):
+    """The two LTC tables of one lobe (core/ltc/fit.py), sphere table in the spare channel."""
+    from ..ltc import fit, sphere_table
+
+    n_lobe, n_ltc, n_sphere = params["fit_samples"]
+    result = fit.fit_table(params["lobe"], size=params["size"], n_moments=params["moment_samples"],
+                           n_lobe=n_lobe, n_ltc=n_ltc, n_sphere=n_sphere, exponent=params["exponent"],
+                           max_iter=params["max_iter"], progress=progress)
+    sphere = sphere_table.sphere_horizon_table(params["size"])
+    zeros = np.zeros_like(result["magnitude"])
+    return {
+        prefix + "_inv": result["packed"].astype(np.float32),
+        prefix + "_mag": np.stack([result["magnitude"], result["fresnel"], zeros, sphere], axis=-1).astype(np.float32),
+    }
+
+
+def _compute(name, progress=None):
+    params = catalog.GROUPS[name].params
+    if name == "ggx_energy":
+        return compute_energy_tables(params["size"], params["samples"], progress)
+    return compute_ltc_tables(name, params, progress)
+
+
+def _print_progress(name, done, total):
+    if done == total or done % max(1, total // 4) == 0:
+        print(f"[bake]   {name}: {done}/{total}", flush=True)
+
+
+def _compute_in_worker(name):
+    """Process-pool entry: compute one group, printing coarse progress itself."""
+    start = time.perf_counter()
+    tables = _compute(name, lambda d, t: _print_progress(name, d, t))
+    return name, tables, time.perf_counter() - start
 
 
 def _metadata(spec, group, digest):
@@ -65,8 +98,9 @@ def _metadata(spec, group, digest):
         "layout_version": catalog.LAYOUT_VERSION,
         "generator": GENERATOR,
         "generator_version": group.generator_version,
-        "samples": int(group.params.get("samples", 0)),
-        "sampler": str(group.params.get("sampler", "")),
+        "samples": int(group.params.get("samples", group.params.get("moment_samples", 0))),
+        "sampler": str(group.params.get("sampler", "hammersley-2d")),
+        "params": json.dumps(group.params, sort_keys=True),
         "inputs_hash": digest,
     }
 
@@ -77,29 +111,59 @@ def group_is_current(group_name, lut_dir, expected_hash=None):
     return all(catalog.table_status(s, lut_dir, expected_hash).state == "ok" for s in specs)
 
 
-def bake(lut_dir=None, force=False, progress=None, groups=None, log=print):
+#: Relative cost of each group (measured: docs/benchmarks/ltc.md); longest first in the pool.
+_COST = {"ltc_ggx": 3.0, "ltc_cloth": 1.2, "ltc_cod_diffuse": 1.1, "ggx_energy": 1.0}
+
+
+def _parallel_results(names, workers):
+    """Compute groups in forked worker processes (POSIX only); yields (name, tables, seconds)."""
+    import multiprocessing
+
+    order = sorted(names, key=lambda n: -_COST.get(n, 1.0))
+    with multiprocessing.get_context("fork").Pool(min(workers, len(order))) as pool:
+        yield from pool.imap_unordered(_compute_in_worker, order)
+
+
+def bake(lut_dir=None, force=False, progress=None, groups=None, log=print, workers=None):
     """Bake every group (or ``groups``) into ``lut_dir``; returns a list of BakeRecord.
 
-    ``progress(group, done, total)`` reports long work; ``log`` receives one line per group.
+    Groups whose files are current are skipped ("nothing to do").  The others are computed in
+    ``workers`` processes (default: one per core, at most one per group; forking needs POSIX,
+    so elsewhere, and inside Blender where the add-on passes workers=1, they run in turn).
+    ``progress(group, done, total)`` reports long work in the serial case; workers print their
+    own progress lines.  ``log`` receives one line per group.
     """
+    import os
+
     lut_dir = Path(lut_dir) if lut_dir is not None else catalog.default_lut_dir()
-    records = []
+    records, todo = {}, []
     for name in groups or catalog.GROUPS:
-        group = catalog.GROUPS[name]
         specs = [s for s in catalog.TABLES.values() if s.group == name]
-        digest = catalog.inputs_hash(name)
         files = tuple(lut_dir / s.filename for s in specs)
-        if not force and group_is_current(name, lut_dir, digest):
+        if not force and group_is_current(name, lut_dir):
             log(f"[bake] {name}: up to date ({', '.join(f.name for f in files)}), nothing to do")
-            records.append(BakeRecord(name, "cached", 0.0, files))
-            continue
-        log(f"[bake] {name}: baking {len(specs)} tables ({group.params})")
-        start = time.perf_counter()
-        tables = _COMPUTE[name](group.params,
-                                (lambda d, t: progress(name, d, t)) if progress else None)
+            records[name] = BakeRecord(name, "cached", 0.0, files)
+        else:
+            log(f"[bake] {name}: baking {len(specs)} tables ({catalog.GROUPS[name].params})")
+            todo.append(name)
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if len(todo) > 1 and workers > 1 and os.name == "posix":
+        results = _parallel_results(todo, workers)
+    else:
+        results = ((n, *_timed(n, (lambda d, t, n=n: progress(n, d, t)) if progress else None)) for n in todo)
+    for name, tables, seconds in results:
+        group = catalog.GROUPS[name]
+        digest = catalog.inputs_hash(name)
+        specs = [s for s in catalog.TABLES.values() if s.group == name]
         for spec in specs:
             exr_io.write_table(lut_dir / spec.filename, tables[spec.name], _metadata(spec, group, digest))
-        seconds = time.perf_counter() - start
-        log(f"[bake] {name}: wrote {', '.join(f.name for f in files)} in {seconds:.1f} s")
-        records.append(BakeRecord(name, "baked", seconds, files))
-    return records
+        log(f"[bake] {name}: wrote {', '.join(s.filename for s in specs)} in {seconds:.1f} s")
+        records[name] = BakeRecord(name, "baked", seconds, tuple(lut_dir / s.filename for s in specs))
+    return [records[name] for name in (groups or catalog.GROUPS)]
+
+
+def _timed(name, progress):
+    start = time.perf_counter()
+    tables = _compute(name, progress)
+    return tables, time.perf_counter() - start

@@ -25,6 +25,8 @@ LAYOUT_VERSION = 1
 AXIS_U_ROUGHNESS = "u: Blender roughness r (GGX alpha = max(r^2, 1e-4)); node i at r = i/(W-1), texel centre (i+0.5)/W"
 AXIS_V_MU = ("v: mu = cos(theta_view); node j at mu = j/(H-1), texel centre (j+0.5)/H "
              "(Blender row j counted from the bottom)")
+AXIS_V_SQRT_ONE_MINUS_MU = ("v: sqrt(1 - mu), mu = cos(theta_view); node j at v = j/(H-1), texel centre (j+0.5)/H "
+                            "(Blender row j counted from the bottom); the fit clamps mu >= 1e-3")
 
 
 @dataclass(frozen=True)
@@ -71,6 +73,32 @@ GROUPS = {
     ),
 }
 
+LTC_SIZE = 64
+
+#: Settings of the LTC fit (core/ltc/fit.py), measured in docs/benchmarks/ltc.md.
+LTC_FIT = {"size": LTC_SIZE, "moment_samples": 1 << 14, "fit_samples": [384, 384, 96], "exponent": 1.0,
+           "max_iter": 300, "fit_mu_min": 1e-3}
+
+_LTC_SOURCES = ("core/ltc/fit.py", "core/ltc/lobes.py", "core/ltc/matrix.py", "core/ltc/optimize.py",
+                "core/ltc/sphere_table.py", "core/microfacet.py", "core/diffuse.py", "core/cloth.py",
+                "core/sampling.py", "core/conventions.py", "core/shading_ops.py", "core/lut/bake.py")
+
+#: LTC lobes: table prefix -> (lobe name in core.ltc.lobes, description)
+LTC_LOBES = {
+    "ltc_ggx": ("ggx", "single-scattering GGX (F = 1, height-correlated Smith G2)"),
+    "ltc_cod_diffuse": ("cod_diffuse", "Call of Duty WWII multiscattering diffuse (albedo 1)"),
+    "ltc_cloth": ("cloth", "Ashikhmin velvet + Neubelt-Pettineo visibility (colour 1)"),
+}
+
+for _prefix, (_lobe, _text) in LTC_LOBES.items():
+    GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=dict(LTC_FIT, lobe=_lobe),
+                                sources=_LTC_SOURCES)
+
+LTC_INV_CHANNELS = ("R = c0 = Minv_xx, G = c1 = Minv_zx, B = c2 = Minv_xz, A = c3 = Minv_zz "
+                    "(Minv normalised so that Minv_yy = 1)")
+LTC_MAG_CHANNELS = ("R = magnitude = int f cos, G = fresnel = int f cos (1 - v.h)^5, B = 0, "
+                    "A = horizon-clipped sphere ratio on its own axes (u = z/2 + 1/2, v = |F|)")
+
 TABLES = {
     spec.name: spec
     for spec in (
@@ -95,6 +123,15 @@ TABLES = {
                         "scale + bias = E from the same samples"),
     )
 }
+for _prefix, (_lobe, _text) in LTC_LOBES.items():
+    TABLES[_prefix + "_inv"] = TableSpec(
+        name=_prefix + "_inv", filename=_prefix + "_inv.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
+        channels=LTC_INV_CHANNELS, description=f"LTC inverse matrix fitted to {_text}",
+        axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
+    TABLES[_prefix + "_mag"] = TableSpec(
+        name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
+        channels=LTC_MAG_CHANNELS, description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
+        axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
 
 _PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 

@@ -69,3 +69,31 @@ class EnergyTables:
         u, v = energy_lut_uv(mu, roughness)
         rg = sample_bilinear(self.tables["ggx_split_sum"], u, v)
         return rg[..., 0], rg[..., 1]
+
+
+def ltc_lut_uv(mu, roughness, size=catalog.LTC_SIZE):
+    """(u, v) of the LTC tables: u from roughness, v from sqrt(1 - mu) (ltc.md §5.2)."""
+    return lut_coordinate(roughness, size), lut_coordinate(op.sqrt(1.0 - op.saturate(mu)), size)
+
+
+class LtcTables:
+    """The LTC tables of one LUT folder (``catalog.LTC_LOBES``), sampled as Blender samples them."""
+
+    def __init__(self, lut_dir=None, prefixes=None):
+        lut_dir = Path(lut_dir) if lut_dir is not None else catalog.default_lut_dir()
+        self.tables = {}
+        for prefix in prefixes or catalog.LTC_LOBES:
+            for suffix in ("_inv", "_mag"):
+                spec = catalog.TABLES[prefix + suffix]
+                self.tables[spec.name], _ = exr_io.read_table(lut_dir / spec.filename, spec.name, spec.shape)
+
+    def lookup(self, prefix, mu, roughness):
+        """(packed Minv (..., 4), magnitude (...), fresnel (...)) at (mu, r)."""
+        u, v = ltc_lut_uv(mu, roughness)
+        packed = sample_bilinear(self.tables[prefix + "_inv"], u, v)
+        mag = sample_bilinear(self.tables[prefix + "_mag"], u, v)
+        return packed, mag[..., 0], mag[..., 1]
+
+    def sphere_table(self, prefix="ltc_ggx"):
+        """The horizon-clipped sphere table stored in the spare channel, (H, W) [len axis, z axis]."""
+        return self.tables[prefix + "_mag"][..., 3]
