@@ -90,3 +90,14 @@ def average_energy_polynomial_talk(smoothness):
     r = 1.04997 + s * r
     r = 0.409255 + s * r
     return np.minimum(0.999, r)
+
+
+def fdez_aguera_area_scale(f0, e, f90=1.0):
+    """Scale for single-scattered specular under area lights: 1 + F_avg (1 - E) / (1 - F_avg (1 - E)).
+
+    The talk's "approximation to Fdez-Aguera": f_ms = F_avg (1 - E(mu)) / (1 - F_avg (1 - E(mu))) f_ss,
+    with E(mu) the magnitude of the GGX LTC table.  Equals 1/E for F0 = F90 = 1 (white furnace).
+    """
+    f_avg = fresnel_average(f0, f90)
+    lost = f_avg * (1.0 - e)
+    return 1.0 + lost / op.maximum(1.0 - lost, COS_EPS)
