@@ -8,9 +8,11 @@ Steps (each prints what it does):
 2. Numpy energy checks: E and E_avg against Cycles' own table, the Kulla-Conty white
    furnace with the LUT-driven lobe, the Fdez-Aguera and Turquin furnaces, and the talk's
    E_avg polynomial.
-3. Cycles render check: spheres under a white world (scripts/validate_energy.py).
-4. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
-Later issues add the demo lookdev scene and the LTC / node-group validations here.
+3. LTC area lights (numpy): end-to-end error of the LTC tables on seeded random quads and
+   disks against brute-force integrals (a smaller set than scripts/benchmark_ltc.py).
+4. Cycles render check: spheres under a white world (scripts/validate_energy.py).
+5. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
+Later issues add the demo lookdev scene and the node-group validations here.
 """
 from __future__ import annotations
 
@@ -35,6 +37,8 @@ E_VS_CYCLES_TOL = 1e-3          # |E - Cycles table| at its nodes, mu >= 0.1
 E_AVG_R1 = (0.409, 1e-3)        # E_avg(r = 1)
 FURNACE_TOL = 1e-3              # Kulla-Conty E_ss + E_ms = 1, every r, mu >= 0.1
 FDEZ_FURNACE_TOL = 5e-3         # Fdez-Aguera environment BRDF with F0 = 1
+LTC_MEDIAN_TOL = {"ggx": 0.015, "cod_diffuse": 0.01, "cloth": 0.01}   # quads, lights > 10% of the albedo
+LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main job
 
 
 def _progress(group, done, total):
@@ -43,7 +47,7 @@ def _progress(group, done, total):
 
 
 def step_luts(lut_dir):
-    print(f"[1/4] LUTs in {lut_dir}", flush=True)
+    print(f"[1/5] LUTs in {lut_dir}", flush=True)
     records = bake.bake(lut_dir, progress=_progress, log=lambda line: print("      " + line, flush=True))
     status = catalog.lut_status(lut_dir)
     return {"records": [{"group": r.group, "state": r.state, "seconds": round(r.seconds, 2)} for r in records],
@@ -52,7 +56,7 @@ def step_luts(lut_dir):
 
 
 def step_numpy_checks(lut_dir):
-    print("[2/4] numpy energy checks", flush=True)
+    print("[2/5] numpy energy checks", flush=True)
     t0 = time.perf_counter()
     tables = lookup.EnergyTables(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -83,7 +87,7 @@ def step_numpy_checks(lut_dir):
 
 
 def step_render(out_dir, lut_dir, resolution, samples):
-    print("[3/4] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
+    print("[4/5] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
     import validate_energy  # imports bpy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -91,6 +95,19 @@ def step_render(out_dir, lut_dir, resolution, samples):
                                  log=lambda line: print("      " + line, flush=True), **options)
     result["summary_markdown"] = "```\n" + validate_energy.format_table(result) + "\n```"
     return result
+
+
+def step_ltc(lut_dir):
+    print("[3/5] LTC area lights: random quads and disks vs brute force", flush=True)
+    import benchmark_ltc
+
+    t0 = time.perf_counter()
+    tables = {name: benchmark_ltc.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}
+    results = benchmark_ltc.end_to_end(tables, None, *LTC_LIGHTS)
+    out = {"lights_per_brdf": {"quads": LTC_LIGHTS[0], "disks": LTC_LIGHTS[1]}, "results": results,
+           "seconds": round(time.perf_counter() - t0, 1)}
+    out["passed"] = all(results[f"{lobe}/quad"]["ours"]["rel_median"] <= tol for lobe, tol in LTC_MEDIAN_TOL.items())
+    return out
 
 
 def write_report(report, out_dir):
@@ -118,6 +135,18 @@ def write_report(report, out_dir):
               f"| Kulla-Conty furnace with the talk's polynomial as E_avg, mu >= 0.1 | "
               f"{n['talk_polynomial']['furnace_max_err_mu_ge_0.1']:.3f} | reported (why the table's E_avg ships) |",
               ""]
+    ltc = report["ltc"]
+    lines += ["## LTC area lights (numpy, seeded random lights vs brute force)", "",
+              f"{ltc['lights_per_brdf']['quads']} quads and {ltc['lights_per_brdf']['disks']} disks per BRDF; relative "
+              "error on lights carrying > 10% of the lobe's albedo (acceptance: median of quads "
+              + ", ".join(f"{k} <= {100 * v:.1f}%" for k, v in LTC_MEDIAN_TOL.items())
+              + "). Full benchmark: `python scripts/benchmark_ltc.py` (docs/benchmarks/ltc.md).", "",
+              "| BRDF / light | n (>10%) | rel median | rel p90 | abs/albedo median |", "|---|---|---|---|---|"]
+    for key, e in ltc["results"].items():
+        o = e["ours"]
+        lines.append(f"| {key} | {o['lights_over_10pct']}/{o['lights']} | {100 * o['rel_median']:.2f}% | "
+                     f"{100 * o['rel_p90']:.1f}% | {100 * o['abs_over_albedo_median']:.2f}% |")
+    lines.append("")
     render = report.get("render")
     lines += ["## Cycles render check (spheres under a white world)", ""]
     if render is None:
@@ -147,13 +176,14 @@ def main(argv=None):
         print("LUTs are not usable; see the status above", file=sys.stderr)
         return 1
     report["numpy_checks"] = step_numpy_checks(args.lut_dir)
+    report["ltc"] = step_ltc(args.lut_dir)
     report["render"] = None
     if not args.skip_render:
         report["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples)
-    report["passed"] = bool(report["luts"]["passed"] and report["numpy_checks"]["passed"]
+    report["passed"] = bool(report["luts"]["passed"] and report["numpy_checks"]["passed"] and report["ltc"]["passed"]
                             and (report["render"] is None or report["render"].get("passed", False)))
     report["seconds"] = time.perf_counter() - t0
-    print("[4/4] report", flush=True)
+    print("[5/5] report", flush=True)
     write_report(report, args.out)
     print((args.out / "report.md").read_text())
     print(f"report written to {args.out / 'report.md'} and report.json")
