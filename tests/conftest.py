@@ -38,3 +38,16 @@ def empty_scene(bpy_module):
     """Empty the open file (keeps preferences and enabled extensions)."""
     bpy_module.ops.wm.read_homefile(use_empty=True)
     return bpy_module.context.scene
+
+
+@pytest.fixture(scope="session")
+def lut_dir(tmp_path_factory):
+    """The shipped LUT folder when it is current, else a fresh bake into a temp folder."""
+    from rt_lookdev.core.lut import bake, catalog
+
+    shipped = catalog.default_lut_dir()
+    if all(s.state == "ok" for s in catalog.lut_status(shipped)):
+        return shipped
+    out = tmp_path_factory.mktemp("luts")
+    bake.bake(out)
+    return out

@@ -128,8 +128,8 @@ def bake(lut_dir=None, force=False, progress=None, groups=None, log=print, worke
     """Bake every group (or ``groups``) into ``lut_dir``; returns a list of BakeRecord.
 
     Groups whose files are current are skipped ("nothing to do").  The others are computed in
-    ``workers`` processes (default: one per core, at most one per group; forking needs POSIX,
-    so elsewhere, and inside Blender where the add-on passes workers=1, they run in turn).
+    ``workers`` processes (default: one per core, at most one per group).  Forking needs POSIX,
+    so elsewhere they run in turn; a caller inside Blender should pass workers=1.
     ``progress(group, done, total)`` reports long work in the serial case; workers print their
     own progress lines.  ``log`` receives one line per group.
     """

@@ -15,7 +15,6 @@ import pytest
 pytest.importorskip("OpenEXR")
 
 import validate_energy as ve  # noqa: E402  (scripts/ is on sys.path via tests/conftest.py)
-from rt_lookdev.core.lut import bake, catalog  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -24,21 +23,11 @@ RESOLUTION = 96        # pixels per sphere cell: ~6000 sphere pixels each
 SAMPLES = 128          # per-bin standard errors 1e-4 .. 6e-4 (GGX), far inside 0.005 (MS)
 
 
-@pytest.fixture(scope="session")
-def energy_lut_dir(tmp_path_factory):
-    shipped = catalog.default_lut_dir()
-    if all(s.state == "ok" for s in catalog.lut_status(shipped)):
-        return shipped
-    out = tmp_path_factory.mktemp("luts")
-    bake.bake(out)
-    return out
-
-
 @pytest.fixture(scope="module")
-def validation(bpy_module, energy_lut_dir, tmp_path_factory):
+def validation(bpy_module, lut_dir, tmp_path_factory):
     out = tmp_path_factory.mktemp("energy_render")
     res = ve.run(resolution=RESOLUTION, samples=SAMPLES, roughness=ROUGHNESS, out_dir=out,
-                 lut_dir=energy_lut_dir, exact=False, keep_exr=False, log=lambda *a: None)
+                 lut_dir=lut_dir, exact=False, keep_exr=False, log=lambda *a: None)
     print(ve.format_table(res))
     return res, out
 
