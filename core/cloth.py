@@ -26,7 +26,7 @@ def ashikhmin_velvet_distribution(n_dot_h, alpha):
     s2 = op.maximum((1.0 - c) * (1.0 + c), SIN2_MIN)
     peak = 4.0 * op.exp(-c2 / (a2 * s2)) / (s2 * s2)
     D = (1.0 + peak) / (np.pi * (1.0 + 4.0 * a2))
-    return op.select(np.asarray(n_dot_h) > 0.0, D, 0.0)
+    return op.select(op.greater(n_dot_h, 0.0), D, 0.0)
 
 
 def neubelt_visibility(mu_l, mu_v):
@@ -40,8 +40,7 @@ def ashikhmin_cloth_brdf(mu_l, mu_v, n_dot_h, alpha):
     f = D_velvet(h) V_neubelt(l, v).  Zero below either horizon.  Reciprocal.
     """
     f = ashikhmin_velvet_distribution(n_dot_h, alpha) * neubelt_visibility(mu_l, mu_v)
-    above = (np.asarray(mu_l) > 0.0) & (np.asarray(mu_v) > 0.0)
-    return op.select(above, f, 0.0)
+    return op.select(op.logical_and(op.greater(mu_l, 0.0), op.greater(mu_v, 0.0)), f, 0.0)
 
 
 def disney_sheen(l_dot_h):

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import shading_ops as op
+
 #: Smallest GGX alpha used anywhere.  alpha**2 = 1e-8 keeps D(h) <= 1/(pi*1e-8) ~ 3e7,
 #: finite in float32, and the E table at r = 0 is indistinguishable from a mirror
 #: (E = 1 to 1e-7 for mu >= 1e-3).
@@ -26,6 +28,9 @@ COS_EPS = 1e-7
 
 def alpha_from_roughness(r):
     """GGX alpha from Blender roughness: alpha = max(r^2, ALPHA_MIN) (Burley 2012)."""
+    if op.is_expr(r):
+        r = op.saturate(r)
+        return op.maximum(r * r, ALPHA_MIN)
     r = np.asarray(r)
     r = np.clip(r if r.dtype.kind == "f" else r.astype(np.float64), 0.0, 1.0)
     return np.maximum(r * r, ALPHA_MIN)

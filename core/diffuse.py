@@ -53,8 +53,8 @@ def cod_multiscatter_diffuse(albedo, mu_l, mu_v, n_dot_h, l_dot_h, alpha):
     fd = op.mix(f0, f1, op.saturate(2.2 * g - 0.5))
     fb = ((34.5 * g - 59.0) * g + 24.5) * ldh * op.exp2(
         -op.maximum(73.2 * g - 21.2, 8.9) * op.sqrt(n_dot_h))
-    above = (np.asarray(mu_l) > 0.0) & (np.asarray(mu_v) > 0.0)
-    return op.select(above, np.asarray(albedo) / np.pi * (fd + fb), 0.0)
+    above = op.logical_and(op.greater(mu_l, 0.0), op.greater(mu_v, 0.0))
+    return op.select(above, albedo * (1.0 / np.pi) * (fd + fb), 0.0)
 
 
 def wrapped_diffuse_cosine(mu_l, wrap):
@@ -81,13 +81,10 @@ def wrapped_normal(n, l, wrap):
     L = -N and w = 1 the sum is the zero vector; N is returned there (Blender's Normalize
     would give 0, so nodes select N explicitly too).
     """
-    n, l = np.asarray(n), np.asarray(l)
     w = op.saturate(wrap)
     cos_theta = op.dot(n, l)
     wrapped = op.saturate((cos_theta + w) / (1.0 + w))
     sin_phi = op.mix(w, 0.0, wrapped)
     cos_phi = op.sqrt(1.0 - sin_phi * sin_phi)
-    tilted = cos_phi[..., None] * n + sin_phi[..., None] * op.cross(op.cross(n, l), n)
-    out = op.normalize(tilted)
-    degenerate = op.dot(tilted, tilted) <= 0.0
-    return np.where(degenerate[..., None], n, out)
+    tilted = op.scale(n, cos_phi) + op.scale(op.cross(op.cross(n, l), n), sin_phi)
+    return op.vselect(op.greater(op.dot(tilted, tilted), 0.0), op.normalize(tilted), n)

@@ -16,12 +16,12 @@ def window_falloff(distance, radius):
     x = op.safe_div(distance, radius)
     x2 = x * x
     w = op.saturate(1.0 - x2 * x2)
-    return op.select(np.asarray(radius) > 0.0, w * w, 0.0)
+    return op.select(op.greater(radius, 0.0), w * w, 0.0)
 
 
 def inverse_square_falloff(distance, min_distance=MIN_DISTANCE):
     """1 / max(d^2, d_min^2): the inverse-square law, clamped at 1 cm (Lagarde & de Rousiers 2014)."""
-    d2 = op.maximum(np.asarray(distance) ** 2, min_distance * min_distance)
+    d2 = op.maximum(distance * distance, min_distance * min_distance)
     return 1.0 / d2
 
 
@@ -32,8 +32,8 @@ def cone_falloff(cos_to_axis, inner_angle, outer_angle):
     spot size), a/2 the angle between the spot axis and the direction to the point, so
     ``cos_to_axis`` = cos(a/2).  inner >= outer gives a hard edge at the outer angle.
     """
-    cos_outer = np.cos(0.5 * np.asarray(outer_angle))
-    cos_inner = np.cos(0.5 * np.minimum(inner_angle, outer_angle))
+    cos_outer = op.cos(0.5 * outer_angle)
+    cos_inner = op.cos(0.5 * op.minimum(inner_angle, outer_angle))
     return op.saturate((cos_to_axis - cos_outer) / op.maximum(cos_inner - cos_outer, ANGLE_EPS))
 
 
@@ -42,4 +42,4 @@ def projector_distance(diameter, outer_angle):
 
     The talk's quad-to-spot fallback; phi = outer full cone angle in (0, pi).
     """
-    return 0.5 * np.asarray(diameter) / op.maximum(np.tan(0.5 * np.asarray(outer_angle)), ANGLE_EPS)
+    return 0.5 * diameter / op.maximum(op.tan(0.5 * outer_angle), ANGLE_EPS)

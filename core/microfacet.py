@@ -27,7 +27,7 @@ def ggx_distribution(n_dot_h, alpha):
     c = op.saturate(n_dot_h)
     d = (1.0 - c) * (1.0 + c) + a2 * c * c
     D = a2 / (np.pi * d * d)
-    return op.select(op.maximum(n_dot_h, 0.0) > 0.0, D, 0.0)
+    return op.select(op.greater(n_dot_h, 0.0), D, 0.0)
 
 
 def _smith_root(mu, a2):
@@ -76,8 +76,7 @@ def ggx_brdf(mu_l, mu_v, n_dot_h, v_dot_h, alpha, f0=1.0, f90=1.0):
 
     f = (fresnel_schlick(f0, v_dot_h, f90) * ggx_distribution(n_dot_h, alpha)
          * smith_visibility_height_correlated(mu_l, mu_v, alpha))
-    above = (np.asarray(mu_l) > 0.0) & (np.asarray(mu_v) > 0.0)
-    return op.select(above, f, 0.0)
+    return op.select(op.logical_and(op.greater(mu_l, 0.0), op.greater(mu_v, 0.0)), f, 0.0)
 
 
 def sample_ggx_vndf(view, alpha, u1, u2):

@@ -23,11 +23,19 @@ normalize(v)        zero vector for |v| = 0                 same (5.0 GLSL check
 ==================  ======================================  ==============================
 
 All functions accept scalars or numpy arrays (float32 or float64) and broadcast; vectors
-are arrays whose last axis has length 3.
+are arrays whose last axis has length 3.  Given an IR expression (``core.ir.Expr``) as any
+argument, each function instead adds the equivalent node(s) to that expression's graph, so
+the same shading code is traced for the numpy and Blender node backends (core/ir).
 """
 from __future__ import annotations
 
 import numpy as np
+
+from .ir.expr import graph_of, is_expr
+
+
+def _node(op, *args):
+    return graph_of(*args).make(op, args)
 
 
 def _arr(x):
@@ -40,6 +48,8 @@ def _arr(x):
 
 def safe_div(a, b):
     """a / b with Blender's Divide semantics: 0 where b == 0."""
+    if is_expr(a, b):
+        return _node("divide", a, b)
     a, b = np.broadcast_arrays(_arr(a), _arr(b))
     out = np.zeros(a.shape, dtype=np.result_type(a, b))
     np.divide(a, b, out=out, where=(b != 0))
@@ -48,6 +58,8 @@ def safe_div(a, b):
 
 def sqrt(a):
     """Square root with Blender semantics: 0 for a <= 0."""
+    if is_expr(a):
+        return _node("sqrt", a)
     return np.sqrt(np.maximum(_arr(a), 0.0))
 
 
@@ -55,30 +67,42 @@ def inverse_sqrt(a, eps):
     """1/sqrt(max(a, eps)); eps > 0 is required because EEVEE's inversesqrt is unguarded."""
     if not eps > 0:
         raise ValueError("inverse_sqrt needs an explicit eps > 0")
+    if is_expr(a):
+        return _node("inverse_sqrt", maximum(a, eps))
     return 1.0 / np.sqrt(np.maximum(_arr(a), eps))
 
 
 def acos(a):
     """arccos of the input clamped to [-1, 1] (the clamp is explicit in nodes too)."""
+    if is_expr(a):
+        return _node("arccosine", clamp(a, -1.0, 1.0))
     return np.arccos(np.clip(_arr(a), -1.0, 1.0))
 
 
 def asin(a):
     """arcsin of the input clamped to [-1, 1]."""
+    if is_expr(a):
+        return _node("arcsine", clamp(a, -1.0, 1.0))
     return np.arcsin(np.clip(_arr(a), -1.0, 1.0))
 
 
 def exp(a):
+    if is_expr(a):
+        return _node("exponent", a)
     return np.exp(_arr(a))
 
 
 def exp2(a):
     """2**a (Blender: Power node with base 2)."""
+    if is_expr(a):
+        return _node("power", 2.0, a)
     return np.exp2(_arr(a))
 
 
 def log2(a):
     """log2(a) with Blender's Logarithm semantics: 0 for a <= 0."""
+    if is_expr(a):
+        return _node("log2", a)
     a = _arr(a)
     out = np.zeros(a.shape, dtype=a.dtype)
     np.log2(a, out=out, where=(a > 0))
@@ -87,21 +111,28 @@ def log2(a):
 
 def pow5(a):
     """a**5 by multiplication (no Power node, so no negative-base rule applies)."""
+    if is_expr(a):
+        a2 = a * a
+        return a2 * a2 * a
     a = _arr(a)
     a2 = a * a
     return a2 * a2 * a
 
 
 def minimum(a, b):
+    if is_expr(a, b):
+        return _node("minimum", a, b)
     return np.minimum(_arr(a), _arr(b))
 
 
 def maximum(a, b):
+    if is_expr(a, b):
+        return _node("maximum", a, b)
     return np.maximum(_arr(a), _arr(b))
 
 
 def clamp(a, lo, hi):
-    return np.minimum(np.maximum(_arr(a), lo), hi)
+    return minimum(maximum(a, lo), hi)
 
 
 def saturate(a):
@@ -111,31 +142,90 @@ def saturate(a):
 
 def mix(a, b, t):
     """Linear interpolation a + (b - a) t (HLSL lerp, Blender Mix node)."""
+    if is_expr(a, b, t):
+        return a + (b - a) * t
     a, b, t = _arr(a), _arr(b), _arr(t)
     return a + (b - a) * t
 
 
 def select(condition, if_true, if_false):
     """Per-element choice; in nodes a Compare/Greater Than result drives a Mix factor."""
+    if is_expr(condition, if_true, if_false):
+        return _node("select", condition, if_true, if_false)
     return np.where(condition, _arr(if_true), _arr(if_false))
+
+
+def vselect(condition, if_true, if_false):
+    """Per-element choice between vectors (a Mix node in vector mode)."""
+    if is_expr(condition, if_true, if_false):
+        return _node("vselect", condition, if_true, if_false)
+    return np.where(np.asarray(condition)[..., None], _arr(if_true), _arr(if_false))
+
+
+def greater(a, b):
+    """a > b: a boolean array, or a 0/1 float in nodes (Math "Greater Than")."""
+    if is_expr(a, b):
+        return _node("greater_than", a, b)
+    return _arr(a) > _arr(b)
+
+
+def less(a, b):
+    """a < b (Math "Less Than")."""
+    if is_expr(a, b):
+        return _node("less_than", a, b)
+    return _arr(a) < _arr(b)
+
+
+def logical_and(a, b):
+    """Both conditions (in nodes: the product of two 0/1 floats)."""
+    if is_expr(a, b):
+        return _node("multiply", a, b)
+    return np.logical_and(a, b)
+
+
+def cos(a):
+    if is_expr(a):
+        return _node("cosine", a)
+    return np.cos(_arr(a))
+
+
+def tan(a):
+    if is_expr(a):
+        return _node("tangent", a)
+    return np.tan(_arr(a))
 
 
 # --- vector math (last axis = xyz) -------------------------------------------------------
 
 def dot(a, b):
+    if is_expr(a, b):
+        return _node("dot", a, b)
     return np.sum(_arr(a) * _arr(b), axis=-1)
 
 
 def cross(a, b):
+    if is_expr(a, b):
+        return _node("cross", a, b)
     return np.cross(_arr(a), _arr(b))
 
 
 def length(v):
+    if is_expr(v):
+        return _node("length", v)
     return np.sqrt(dot(v, v))
+
+
+def scale(v, s):
+    """Vector v times scalar s (Vector Math "Scale")."""
+    if is_expr(v, s):
+        return _node("vscale", v, s)
+    return _arr(v) * _arr(s)[..., None]
 
 
 def normalize(v):
     """v/|v|, and the zero vector for |v| == 0 (Blender's Vector Math Normalize)."""
+    if is_expr(v):
+        return _node("normalize", v)
     v = _arr(v)
     n = length(v)[..., None]
     out = np.zeros(np.broadcast_shapes(v.shape, n.shape), dtype=v.dtype)

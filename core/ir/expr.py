@@ -1,0 +1,209 @@
+"""Expressions: a DAG of Blender-node operations with sharing, folding and type checks.
+
+Every ``Expr`` belongs to a ``Graph``, which interns nodes by (operation, arguments,
+attributes): building the same subexpression twice returns the same node, so common
+subexpressions are shared for free.  An operation whose arguments are all constants is
+evaluated at once (constant folding, with the backend's own semantics), and a ``select``
+with a constant condition keeps only the live branch (dead-branch removal), so a material
+with sheen 0 carries no sheen nodes.
+
+Kinds: "float" (Math node socket), "vector" (Vector Math socket).  Comparisons give floats
+0/1, as Blender's Compare/Greater Than do.  Python control flow on an Expr is refused
+(``__bool__`` raises): write ``select`` instead.
+"""
+from __future__ import annotations
+
+import itertools
+import threading
+
+import numpy as np
+
+FLOAT, VECTOR = "float", "vector"
+
+#: operation -> (argument kinds, result kind).  "vector?"-free: every operation has fixed kinds.
+OPS = {
+    "const": ((), FLOAT), "input": ((), FLOAT), "vconst": ((), VECTOR), "vinput": ((), VECTOR),
+    # Math node (ShaderNodeMath)
+    "add": ((FLOAT, FLOAT), FLOAT), "subtract": ((FLOAT, FLOAT), FLOAT),
+    "multiply": ((FLOAT, FLOAT), FLOAT), "divide": ((FLOAT, FLOAT), FLOAT),
+    "power": ((FLOAT, FLOAT), FLOAT), "sqrt": ((FLOAT,), FLOAT), "inverse_sqrt": ((FLOAT,), FLOAT),
+    "exponent": ((FLOAT,), FLOAT), "log2": ((FLOAT,), FLOAT),
+    "minimum": ((FLOAT, FLOAT), FLOAT), "maximum": ((FLOAT, FLOAT), FLOAT),
+    "less_than": ((FLOAT, FLOAT), FLOAT), "greater_than": ((FLOAT, FLOAT), FLOAT),
+    "absolute": ((FLOAT,), FLOAT), "arccosine": ((FLOAT,), FLOAT), "arcsine": ((FLOAT,), FLOAT),
+    "sine": ((FLOAT,), FLOAT), "cosine": ((FLOAT,), FLOAT), "tangent": ((FLOAT,), FLOAT),
+    # Mix node with a float factor: select(c, a, b) = mix(b, a, c) for c in {0, 1}
+    "select": ((FLOAT, FLOAT, FLOAT), FLOAT),
+    "vselect": ((FLOAT, VECTOR, VECTOR), VECTOR),
+    # Combine / Separate XYZ
+    "combine": ((FLOAT, FLOAT, FLOAT), VECTOR), "x": ((VECTOR,), FLOAT), "y": ((VECTOR,), FLOAT),
+    "z": ((VECTOR,), FLOAT),
+    # Vector Math node (ShaderNodeVectorMath)
+    "vadd": ((VECTOR, VECTOR), VECTOR), "vsubtract": ((VECTOR, VECTOR), VECTOR),
+    "vscale": ((VECTOR, FLOAT), VECTOR), "dot": ((VECTOR, VECTOR), FLOAT),
+    "cross": ((VECTOR, VECTOR), VECTOR), "length": ((VECTOR,), FLOAT), "normalize": ((VECTOR,), VECTOR),
+}
+
+_local = threading.local()
+
+
+class Graph:
+    """Interns expressions; one graph per traced function."""
+
+    def __init__(self):
+        self.nodes = {}
+        self._ids = itertools.count()
+
+    def make(self, op, args=(), attrs=()):
+        if op not in OPS:
+            raise ValueError(f"unknown IR operation {op!r}")
+        kinds, result = OPS[op]
+        args = tuple(self.lift(a) for a in args)
+        if len(args) != len(kinds) or any(a.kind != k for a, k in zip(args, kinds)):
+            raise TypeError(f"{op}: expected {kinds}, got {tuple(a.kind for a in args)}")
+        folded = _simplify(self, op, args)
+        if folded is not None:
+            return folded
+        key = (op, tuple(a.id for a in args), attrs)
+        node = self.nodes.get(key)
+        if node is None:
+            node = Expr(self, next(self._ids), op, args, attrs, result)
+            self.nodes[key] = node
+        return node
+
+    def const(self, value):
+        return self.make("const", attrs=(("value", float(np.float32(value))),))
+
+    def vconst(self, value):
+        return self.make("vconst", attrs=(("value", tuple(float(np.float32(v)) for v in value)),))
+
+    def input(self, name, kind=FLOAT):
+        return self.make("input" if kind == FLOAT else "vinput", attrs=(("name", name),))
+
+    def lift(self, value):
+        if isinstance(value, Expr):
+            if value.graph is not self:
+                raise ValueError("expressions from different graphs cannot be combined")
+            return value
+        arr = np.asarray(value, dtype=np.float64)
+        if arr.ndim == 0:
+            return self.const(arr)
+        if arr.shape == (3,):
+            return self.vconst(arr)
+        raise TypeError(f"cannot use a value of shape {arr.shape} in a traced expression")
+
+
+class Expr:
+    __slots__ = ("graph", "id", "op", "args", "attrs", "kind")
+
+    def __init__(self, graph, ident, op, args, attrs, kind):
+        self.graph, self.id, self.op, self.args, self.attrs, self.kind = graph, ident, op, args, attrs, kind
+
+    def attr(self, name):
+        return dict(self.attrs)[name]
+
+    @property
+    def is_const(self):
+        return self.op in ("const", "vconst")
+
+    def __repr__(self):
+        return f"Expr#{self.id}<{self.op} {self.kind}>"
+
+    def __bool__(self):
+        raise TypeError("a traced expression has no truth value; use shading_ops.select")
+
+    __hash__ = object.__hash__
+
+    def _bin(self, other, op, vop=None, reverse=False):
+        g = self.graph
+        a, b = (g.lift(other), self) if reverse else (self, g.lift(other))
+        if a.kind == VECTOR or b.kind == VECTOR:
+            if vop is None:
+                raise TypeError(f"{op} is not defined for vectors")
+            if vop == "vscale":
+                v, s = (a, b) if a.kind == VECTOR else (b, a)
+                return g.make("vscale", (v, s))
+            return g.make(vop, (a, b))
+        return g.make(op, (a, b))
+
+    def __add__(self, o): return self._bin(o, "add", "vadd")
+    def __radd__(self, o): return self._bin(o, "add", "vadd", True)
+    def __sub__(self, o): return self._bin(o, "subtract", "vsubtract")
+    def __rsub__(self, o): return self._bin(o, "subtract", "vsubtract", True)
+    def __mul__(self, o): return self._bin(o, "multiply", "vscale")
+    def __rmul__(self, o): return self._bin(o, "multiply", "vscale", True)
+    def __truediv__(self, o): return self._bin(o, "divide")
+    def __rtruediv__(self, o): return self._bin(o, "divide", reverse=True)
+    def __gt__(self, o): return self._bin(o, "greater_than")
+    def __lt__(self, o): return self._bin(o, "less_than")
+
+    def __neg__(self):
+        return self * -1.0 if self.kind == FLOAT else self.graph.make("vscale", (self, self.graph.const(-1.0)))
+
+    def __pow__(self, exponent):
+        if isinstance(exponent, (int, np.integer)) and 1 <= exponent <= 5:
+            result = self
+            for _ in range(int(exponent) - 1):
+                result = result * self
+            return result
+        return self.graph.make("power", (self, exponent))
+
+
+def is_expr(*values):
+    return any(isinstance(v, Expr) for v in values)
+
+
+def graph_of(*values):
+    for v in values:
+        if isinstance(v, Expr):
+            return v.graph
+    raise ValueError("no expression among the arguments")
+
+
+def trace(fn, inputs, graph=None):
+    """Call ``fn`` with Expr inputs: ``inputs`` maps argument names to "float" / "vector".
+    Returns (graph, output Expr or tuple of Exprs)."""
+    graph = graph or Graph()
+    args = {name: graph.input(name, kind) for name, kind in inputs.items()}
+    return graph, fn(**args)
+
+
+# --- folding -----------------------------------------------------------------------------------
+
+def _const_value(e):
+    return e.attr("value")
+
+
+def _simplify(graph, op, args):
+    """Constant folding and algebraic identities that hold under Blender's semantics."""
+    if op in ("const", "vconst", "input", "vinput"):
+        return None
+    if all(a.is_const for a in args):
+        from .numpy_backend import apply_op
+
+        value = apply_op(op, [np.asarray(_const_value(a), dtype=np.float32) for a in args], ())
+        return graph.vconst(value) if OPS[op][1] == VECTOR else graph.const(value)
+    if op in ("select", "vselect") and args[0].is_const:
+        return args[1] if _const_value(args[0]) != 0.0 else args[2]
+    if op in ("select", "vselect") and args[1] is args[2]:
+        return args[1]
+    if op == "add":
+        if args[0].is_const and _const_value(args[0]) == 0.0:
+            return args[1]
+        if args[1].is_const and _const_value(args[1]) == 0.0:
+            return args[0]
+    if op in ("subtract",) and args[1].is_const and _const_value(args[1]) == 0.0:
+        return args[0]
+    if op == "multiply":
+        for i in (0, 1):
+            if args[i].is_const and _const_value(args[i]) == 1.0:
+                return args[1 - i]
+            # x * 0 = 0: every value in a guarded graph is finite (no NaN/Inf reaches a node),
+            # so this drops whole branches, e.g. the sheen lobe of a material with sheen 0
+            if args[i].is_const and _const_value(args[i]) == 0.0:
+                return graph.const(0.0)
+    if op in ("divide",) and args[1].is_const and _const_value(args[1]) == 1.0:
+        return args[0]
+    if op == "vscale" and args[1].is_const and _const_value(args[1]) == 1.0:
+        return args[0]
+    return None
