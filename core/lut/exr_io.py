@@ -45,7 +45,11 @@ def write_table(path, table, metadata):
 
     ``metadata`` maps attribute names (without the ``rtl.`` prefix) to str/int/float.
     """
-    import OpenEXR
+    try:
+        import OpenEXR
+    except ImportError as exc:
+        raise LutError("writing LUTs needs the OpenEXR package (pinned in requirements.lock); Blender's "
+                       "bundled Python lacks it: bake with `.venv/bin/python scripts/bake_luts.py`") from exc
 
     table = np.asarray(table, dtype=np.float32)
     if table.ndim != 3 or table.shape[2] != 4:

@@ -167,3 +167,10 @@ def test_energy_lut_matches_cycles_nodes(energy_tables):
     result = validation.cycles_table_comparison(energy_tables)
     assert result["max_abs_diff_E_lut"] < 1e-3 and result["max_abs_diff_E_avg_lut"] < 1e-3
     assert result["E_avg_r1_lut"] == pytest.approx(0.409, abs=1e-3)
+
+
+def test_writing_without_openexr_says_how_to_bake(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "OpenEXR", None)
+    with pytest.raises(exr_io.LutError, match="bake_luts.py"):
+        exr_io.write_table(tmp_path / "x.exr", np.zeros((2, 2, 4), np.float32), {"table": "x"})
+    assert not (tmp_path / "x.exr").exists()
