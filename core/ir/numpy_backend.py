@@ -4,7 +4,8 @@ The semantics follow Cycles' ``kernel/svm/math_util.h`` (float32): Divide return
 divisor; Power returns 0 for a negative base with a fractional exponent; Square Root of a
 negative is 0; Inverse Square Root of a non-positive is 0; Logarithm of a non-positive is 0;
 Arccosine / Arcsine clamp their input to [-1, 1]; Vector Math Normalize of a zero vector is
-zero.  Shading code guards its inputs so that EEVEE (which differs on inverse sqrt and
+zero; Power of a zero base with a negative exponent is 0 (measured with Cycles 5.0.1: numpy
+gives +-inf there; tests/blender/test_node_conformance.py).  Shading code guards its inputs so that EEVEE (which differs on inverse sqrt and
 arccos/arcsin outside the domain) computes the same values; see core/shading_ops.py.
 """
 from __future__ import annotations
@@ -22,7 +23,7 @@ def _safe_div(a, b):
 
 def _safe_pow(a, b):
     a, b = np.broadcast_arrays(a, b)
-    bad = (a < 0) & (b != np.floor(b))
+    bad = ((a < 0) & (b != np.floor(b))) | ((a == 0) & (b < 0))
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         out = np.power(np.where(bad, 1.0, a).astype(a.dtype), b)
     return np.where(bad, 0.0, out).astype(a.dtype)

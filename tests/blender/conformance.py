@@ -1,0 +1,209 @@
+"""Conformance harness: render a node group's output per pixel with Cycles and read it back.
+
+``render_group_outputs(ng, inputs, output_name)`` packs the input arrays into float images
+(3 float inputs per RGB image, one image per vector input), samples them with Closest/EXTEND
+image textures at texel centres (a plane exactly filling an orthographic camera, one pixel per
+texel, a 0.01-pixel Gaussian filter, 1 sample), feeds the group, routes the output through an
+Emission shader (float: Combine Color with R = value; vector: XYZ -> RGB), renders a 32-bit float
+single-layer EXR with Cycles CPU and reads it back with OpenEXR.  Everything it creates is removed
+again, so it can be called repeatedly in the current scene.
+"""
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+LAST_RENDER_SECONDS = [0.0]
+
+
+def _image(bpy, name, rgb):
+    """A float, non-colour image whose texel (row j from the top of ``rgb``, col i) = rgb[j, i]."""
+    h, w, _ = rgb.shape
+    img = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True, is_data=True)
+    img.alpha_mode = "CHANNEL_PACKED"
+    rgba = np.ones((h, w, 4), dtype=np.float32)
+    rgba[..., :3] = rgb
+    img.pixels.foreach_set(np.flipud(rgba).ravel())    # img.pixels row 0 = bottom row
+    return img
+
+
+def _setup_render(scene, w, h, path):
+    scene.render.engine = "CYCLES"
+    cy = scene.cycles
+    cy.device = "CPU"
+    cy.samples = 1
+    cy.use_adaptive_sampling = False
+    cy.use_denoising = False
+    cy.seed = 0
+    cy.max_bounces = 0
+    cy.sample_clamp_direct = 0.0
+    cy.sample_clamp_indirect = 0.0
+    cy.pixel_filter_type = "GAUSSIAN"
+    cy.filter_width = 0.01
+    r = scene.render
+    r.resolution_x, r.resolution_y, r.resolution_percentage = w, h, 100
+    r.film_transparent = False
+    r.dither_intensity = 0.0
+    r.use_compositing = False
+    r.use_sequencer = False
+    vs = scene.view_settings
+    vs.view_transform = "Standard"
+    vs.look = "None"
+    vs.exposure = 0.0
+    vs.gamma = 1.0
+    s = r.image_settings
+    s.media_type = "IMAGE"
+    s.file_format = "OPEN_EXR"
+    s.color_depth = "32"
+    s.color_mode = "RGBA"
+    s.exr_codec = "ZIP"
+    r.filepath = str(path)
+
+
+def _read_exr(path):
+    import OpenEXR
+
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        ch = {n: np.array(c.pixels) for p in f.parts for n, c in p.channels.items()}
+    return np.stack([ch["R"], ch["G"], ch["B"]], axis=-1).astype(np.float32)   # row 0 = top
+
+
+def render_group_outputs(ng, inputs, output_name):
+    """Cycles' value of ``ng``'s output ``output_name`` per pixel for per-pixel ``inputs``.
+
+    ``inputs``: group input name -> float32 array (H, W) (float sockets) or (H, W, 3) (vector).
+    Returns float32 (H, W) or (H, W, 3) in the orientation of the inputs.
+    """
+    import bpy
+
+    arrays = {k: np.asarray(v, dtype=np.float32) for k, v in inputs.items()}
+    shapes = {a.shape[:2] for a in arrays.values()}
+    if len(shapes) != 1:
+        raise ValueError(f"inputs must share one (H, W) shape, got {shapes}")
+    (h0, w0), = shapes
+    # Blender renders at least 4x4 pixels: pad small inputs (edge values) and crop the result
+    h, w = max(h0, 4), max(w0, 4)
+    if (h, w) != (h0, w0):
+        arrays = {k: np.pad(a, [(0, h - h0), (0, w - w0)] + [(0, 0)] * (a.ndim - 2), mode="edge")
+                  for k, a in arrays.items()}
+    scene = bpy.context.scene
+    created = {"images": [], "materials": [], "meshes": [], "objects": [], "cameras": []}
+    old_camera, old_world = scene.camera, scene.world
+    tmp = tempfile.TemporaryDirectory(prefix="rtl-conformance-")
+    try:
+        # --- material: images -> group -> emission ---------------------------------------------
+        mat = bpy.data.materials.new("RTL_conformance")
+        created["materials"].append(mat)
+        nt = mat.node_tree
+        nt.nodes.clear()
+        coord = nt.nodes.new("ShaderNodeTexCoord")
+        group = nt.nodes.new("ShaderNodeGroup")
+        group.node_tree = ng
+        group.location = (600, 0)
+
+        def tex(rgb, idx):
+            img = _image(bpy, f"RTL_conformance_inputs_{idx}", rgb)
+            created["images"].append(img)
+            t = nt.nodes.new("ShaderNodeTexImage")
+            t.image, t.interpolation, t.extension = img, "Closest", "EXTEND"
+            t.location = (0, -300 * idx)
+            nt.links.new(coord.outputs["UV"], t.inputs["Vector"])
+            return t
+
+        floats = [k for k, a in arrays.items() if a.ndim == 2]
+        vectors = [k for k, a in arrays.items() if a.ndim == 3]
+        n_img = 0
+        for start in range(0, len(floats), 3):
+            chunk = floats[start:start + 3]
+            rgb = np.zeros((h, w, 3), dtype=np.float32)
+            for c, k in enumerate(chunk):
+                rgb[..., c] = arrays[k]
+            t = tex(rgb, n_img)
+            n_img += 1
+            sep = nt.nodes.new("ShaderNodeSeparateColor")
+            sep.mode = "RGB"
+            sep.location = (300, -300 * n_img)
+            nt.links.new(t.outputs["Color"], sep.inputs[0])
+            for c, k in enumerate(chunk):
+                nt.links.new(sep.outputs[c], group.inputs[k])
+        for k in vectors:
+            t = tex(arrays[k], n_img)
+            n_img += 1
+            nt.links.new(t.outputs["Color"], group.inputs[k])
+
+        out_socket = group.outputs[output_name]
+        is_vector = out_socket.type == "VECTOR"
+        emission = nt.nodes.new("ShaderNodeEmission")
+        emission.inputs["Strength"].default_value = 1.0
+        emission.location = (1000, 0)
+        if is_vector:
+            nt.links.new(out_socket, emission.inputs["Color"])
+        else:
+            comb = nt.nodes.new("ShaderNodeCombineColor")
+            comb.mode = "RGB"
+            comb.location = (800, 0)
+            comb.inputs[1].default_value = 0.0
+            comb.inputs[2].default_value = 0.0
+            nt.links.new(out_socket, comb.inputs[0])
+            nt.links.new(comb.outputs[0], emission.inputs["Color"])
+        mout = nt.nodes.new("ShaderNodeOutputMaterial")
+        mout.location = (1200, 0)
+        mout.target = "CYCLES"
+        nt.links.new(emission.outputs[0], mout.inputs["Surface"])
+
+        # --- plane exactly filling an orthographic camera ------------------------------------------
+        sx, sy = (w / max(w, h), h / max(w, h))        # half extents; ortho_scale = 2 covers max side
+        mesh = bpy.data.meshes.new("RTL_conformance_plane")
+        created["meshes"].append(mesh)
+        mesh.from_pydata([(-sx, -sy, 0), (sx, -sy, 0), (sx, sy, 0), (-sx, sy, 0)], [], [(0, 1, 2, 3)])
+        uv = mesh.uv_layers.new(name="UVMap")
+        for loop, (u, v) in zip(mesh.loops, [(0, 0), (1, 0), (1, 1), (0, 1)]):
+            uv.data[loop.index].uv = (u, v)
+        mesh.materials.append(mat)
+        mesh.update()
+        plane = bpy.data.objects.new("RTL_conformance_plane", mesh)
+        created["objects"].append(plane)
+        scene.collection.objects.link(plane)
+
+        cam_data = bpy.data.cameras.new("RTL_conformance_camera")
+        created["cameras"].append(cam_data)
+        cam_data.type = "ORTHO"
+        cam_data.ortho_scale = 2.0
+        cam_data.sensor_fit = "AUTO"
+        cam_data.clip_start, cam_data.clip_end = 0.01, 10.0
+        cam = bpy.data.objects.new("RTL_conformance_camera", cam_data)
+        created["objects"].append(cam)
+        cam.location = (0.0, 0.0, 1.0)
+        scene.collection.objects.link(cam)
+        scene.camera = cam
+
+        world = bpy.data.worlds.new("RTL_conformance_world")
+        created["worlds"] = [world]
+        world.color = (0.0, 0.0, 0.0)
+        if world.node_tree is not None:
+            for n in world.node_tree.nodes:
+                if n.bl_idname == "ShaderNodeBackground":
+                    n.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+                    n.inputs["Strength"].default_value = 0.0
+        scene.world = world
+
+        path = Path(tmp.name) / "out.exr"
+        _setup_render(scene, w, h, path)
+        t0 = time.perf_counter()
+        bpy.ops.render.render(write_still=True)
+        LAST_RENDER_SECONDS[0] = time.perf_counter() - t0
+        rgb = _read_exr(path)
+        rgb = rgb[:h0, :w0]
+        return rgb.copy() if is_vector else rgb[..., 0].copy()
+    finally:
+        scene.camera, scene.world = old_camera, old_world
+        for obj in created.get("objects", []):
+            bpy.data.objects.remove(obj, do_unlink=True)
+        for key in ("meshes", "cameras", "materials", "images", "worlds"):
+            coll = getattr(bpy.data, key)
+            for item in created.get(key, []):
+                coll.remove(item)
+        tmp.cleanup()
