@@ -170,24 +170,13 @@ def build_scene(roughness, resolution, segments=256, rings=128):
 
 
 def configure_render(scene, samples, seed, threads=2):
-    """Cycles settings for an unbiased, unclamped, point-sampled linear render."""
-    scene.render.engine = "CYCLES"
+    """Cycles settings for an unbiased, unclamped, point-sampled linear render
+    (addon/render_setup.py), plus what the furnace needs: glossy bounces, no glossy filter."""
+    from rt_lookdev.addon.render_setup import configure_cycles_measurement
+
+    configure_cycles_measurement(scene, samples, seed, threads)
     c = scene.cycles
-    c.device = "CPU"
-    c.samples = int(samples)
-    c.use_adaptive_sampling = False
-    c.seed = int(seed)
-    c.use_animated_seed = False
-    c.use_denoising = False
-    # A point sample at the pixel centre.  Not 'BOX': Cycles' box filter ignores filter_width
-    # and spreads the samples over the whole pixel (measured: 320 fractional-alpha pixels on a
-    # 96 px sphere with BOX at width 0.01, 9 with GAUSSIAN), which mixes background into the
-    # silhouette pixels and biases both their colour and their Normal pass.
-    c.pixel_filter_type = "GAUSSIAN"
-    c.filter_width = 0.01              # the minimum allowed
     c.blur_glossy = 0.0                # "Filter Glossy"
-    c.sample_clamp_direct = 0.0
-    c.sample_clamp_indirect = 0.0
     c.caustics_reflective = True
     c.caustics_refractive = True
     c.max_bounces = 4
@@ -196,14 +185,6 @@ def configure_render(scene, samples, seed, threads=2):
     c.transmission_bounces = 0
     c.volume_bounces = 0
     c.transparent_max_bounces = 0
-    scene.render.film_transparent = False
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = int(threads)
-    vs = scene.view_settings
-    vs.view_transform = "Standard"
-    vs.look = "None"
-    vs.exposure = 0.0
-    vs.gamma = 1.0
     scene.view_layers[0].use_pass_combined = True
     scene.view_layers[0].use_pass_normal = True
     s = scene.render.image_settings

@@ -31,29 +31,15 @@ def _image(bpy, name, rgb):
 
 
 def _setup_render(scene, w, h, path):
-    scene.render.engine = "CYCLES"
-    cy = scene.cycles
-    cy.device = "CPU"
-    cy.samples = 1
-    cy.use_adaptive_sampling = False
-    cy.use_denoising = False
-    cy.seed = 0
-    cy.max_bounces = 0
-    cy.sample_clamp_direct = 0.0
-    cy.sample_clamp_indirect = 0.0
-    cy.pixel_filter_type = "GAUSSIAN"
-    cy.filter_width = 0.01
+    from rt_lookdev.addon.render_setup import configure_cycles_measurement
+
+    configure_cycles_measurement(scene, samples=1, seed=0)
+    scene.cycles.max_bounces = 0
     r = scene.render
     r.resolution_x, r.resolution_y, r.resolution_percentage = w, h, 100
-    r.film_transparent = False
     r.dither_intensity = 0.0
     r.use_compositing = False
     r.use_sequencer = False
-    vs = scene.view_settings
-    vs.view_transform = "Standard"
-    vs.look = "None"
-    vs.exposure = 0.0
-    vs.gamma = 1.0
     s = r.image_settings
     s.media_type = "IMAGE"
     s.file_format = "OPEN_EXR"
