@@ -13,6 +13,7 @@ import bpy
 
 from ..core.ir.expr import FLOAT, VECTOR, Expr
 from ..core.ir.numpy_backend import topological_order
+from ..core.lut import catalog
 
 #: IR operation -> ShaderNodeMath.operation
 MATH_OPS = {
@@ -54,6 +55,22 @@ def _socket(sockets, identifier):
     raise KeyError(identifier)
 
 
+def lut_image(table, lut_dir=None):
+    """The Blender image of a catalog table, loaded once (as ../shared/reference/blender_addon.md
+    §3.1 prescribes: float, Non-Color, channel-packed alpha), packed into the .blend, fake user."""
+    name = f"RTL_{table}"
+    image = bpy.data.images.get(name)
+    if image is None:
+        path = (lut_dir or catalog.default_lut_dir()) / catalog.TABLES[table].filename
+        image = bpy.data.images.load(str(path), check_existing=False)
+        image.name = name
+        image.colorspace_settings.name = "Non-Color"
+        image.alpha_mode = "CHANNEL_PACKED"
+        image.pack()
+        image.use_fake_user = True
+    return image
+
+
 def _depths(order):
     """Longest path from the inputs (inputs and constants at depth 0)."""
     depth = {}
@@ -62,11 +79,12 @@ def _depths(order):
     return depth
 
 
-def build_node_group(name, outputs, input_order=None):
+def build_node_group(name, outputs, input_order=None, lut_dir=None):
     """Build a ShaderNodeTree group computing ``outputs`` (dict output name -> Expr of one Graph).
 
     Group inputs are the graph's ``input``/``vinput`` nodes in ``input_order`` (default: sorted
-    names); group outputs are the dict's keys, in dict order.
+    names); group outputs are the dict's keys, in dict order.  ``lut`` operations become one
+    Image Texture (Linear, EXTEND) per table and coordinate pair, with one Separate Color.
     """
     if not outputs:
         raise ValueError("a node group needs at least one output")
@@ -114,6 +132,7 @@ def build_node_group(name, outputs, input_order=None):
         if n in inputs:
             produced[inputs[n].id] = _socket(group_in.outputs, item.identifier)
     separators = {}       # source vector id -> ShaderNodeSeparateXYZ
+    textures = {}         # (table, u id, v id) -> (Image Texture node, Separate Color node)
 
     def feed(socket, arg):
         if arg.is_const:
@@ -161,6 +180,28 @@ def build_node_group(name, outputs, input_order=None):
                 separators[src.id] = bn
                 place(bn, col, "separate")
             produced[node.id] = bn.outputs[_COMPONENTS[op]]
+            continue
+        elif op == "lut":
+            table, channel = node.attr("table"), node.attr("channel")
+            u, v = node.args
+            key = (table, u.id, v.id)
+            if key not in textures:
+                uv = nodes.new("ShaderNodeCombineXYZ")
+                feed(uv.inputs[0], u)
+                feed(uv.inputs[1], v)
+                place(uv, col, "lut uv")
+                tex = nodes.new("ShaderNodeTexImage")
+                tex.image = lut_image(table, lut_dir)
+                tex.interpolation = "Linear"
+                tex.extension = "EXTEND"
+                links.new(uv.outputs[0], tex.inputs["Vector"])
+                place(tex, col, table)
+                sep = nodes.new("ShaderNodeSeparateColor")
+                links.new(tex.outputs["Color"], sep.inputs[0])
+                place(sep, col, "channels")
+                textures[key] = (tex, sep)
+            tex, sep = textures[key]
+            produced[node.id] = tex.outputs["Alpha"] if channel == 3 else sep.outputs[channel]
             continue
         elif op in VECTOR_OPS:
             operation, slots, out_name = VECTOR_OPS[op]

@@ -195,6 +195,25 @@ def tan(a):
     return np.tan(_arr(a))
 
 
+class Lut:
+    """A lookup table for shading code: its catalog name and its (H, W, 4) data."""
+
+    def __init__(self, name, table):
+        self.name, self.table = name, np.asarray(table)
+
+
+def lut_sample(lut, u, v, channel):
+    """Channel of ``lut`` at texture coordinates (u, v), bilinear with EXTEND (Image Texture node,
+    Linear; core/lut/lookup.py for the texel-centre convention)."""
+    if is_expr(u, v):
+        g = graph_of(u, v)
+        g.luts.setdefault(lut.name, lut.table)
+        return g.make("lut", (u, v), (("table", lut.name), ("channel", int(channel))))
+    from .lut.lookup import sample_bilinear
+
+    return sample_bilinear(lut.table, u, v)[..., channel]
+
+
 # --- vector math (last axis = xyz) -------------------------------------------------------
 
 def dot(a, b):

@@ -35,6 +35,8 @@ OPS = {
     # Mix node with a float factor: select(c, a, b) = mix(b, a, c) for c in {0, 1}
     "select": ((FLOAT, FLOAT, FLOAT), FLOAT),
     "vselect": ((FLOAT, VECTOR, VECTOR), VECTOR),
+    # Image Texture (Linear, EXTEND) at (u, v), one channel: attrs ("table", name), ("channel", 0..3)
+    "lut": ((FLOAT, FLOAT), FLOAT),
     # Combine / Separate XYZ
     "combine": ((FLOAT, FLOAT, FLOAT), VECTOR), "x": ((VECTOR,), FLOAT), "y": ((VECTOR,), FLOAT),
     "z": ((VECTOR,), FLOAT),
@@ -52,6 +54,7 @@ class Graph:
 
     def __init__(self):
         self.nodes = {}
+        self.luts = {}          # table name -> (H, W, 4) array, for the numpy backend
         self._ids = itertools.count()
 
     def make(self, op, args=(), attrs=()):
@@ -176,7 +179,7 @@ def _const_value(e):
 
 def _simplify(graph, op, args):
     """Constant folding and algebraic identities that hold under Blender's semantics."""
-    if op in ("const", "vconst", "input", "vinput"):
+    if op in ("const", "vconst", "input", "vinput", "lut"):
         return None
     if all(a.is_const for a in args):
         from .numpy_backend import apply_op

@@ -99,6 +99,12 @@ def evaluate(outputs, inputs, dtype=np.float32):
             cache[node.id] = np.asarray(node.attr("value"), dtype=dtype)
         elif node.op in ("input", "vinput"):
             cache[node.id] = np.asarray(inputs[node.attr("name")], dtype=dtype)
+        elif node.op == "lut":
+            from ..lut.lookup import sample_bilinear
+
+            u, v = (cache[a.id] for a in node.args)
+            table = node.graph.luts[node.attr("table")]
+            cache[node.id] = sample_bilinear(table, u, v)[..., node.attr("channel")].astype(dtype)
         else:
             cache[node.id] = apply_op(node.op, [cache[a.id] for a in node.args], node.attrs).astype(dtype, copy=False)
     result = tuple(cache[o.id] for o in outs)

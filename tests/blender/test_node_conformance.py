@@ -160,7 +160,7 @@ def test_every_ir_operation_renders_like_numpy(empty_scene):
     outputs["const_arg"] = g.make("power", (g.const(2.0), a))          # a constant on a socket
     outputs["vconst_arg"] = g.make("cross", (g.vconst((0.0, 0.0, 1.0)), u))
     covered = {n.op for n in topological_order(list(outputs.values()))}
-    assert covered == set(OPS), set(OPS) - covered
+    assert covered | {"lut"} == set(OPS), set(OPS) - covered      # "lut": test_lut_lookup_matches
 
     ng = build_node_group("RTL_all_ops", outputs, input_order=["a", "b", "u", "v"])
     assert len(ng.nodes) == _expected_node_count(outputs)
@@ -193,3 +193,30 @@ def test_power_of_zero_with_negative_exponent(empty_scene):
     ref = evaluate(out, vals)
     np.testing.assert_array_equal(got, ref)
     assert np.all(ref == 0.0)
+
+
+def test_lut_lookup_matches(empty_scene, lut_dir):
+    """Table lookups in nodes: Image Texture (Linear, EXTEND) against core.lut.lookup.sample_bilinear,
+    every channel, coordinates inside and outside the texel-centre range."""
+    from rt_lookdev.addon.node_emit import build_node_group, node_group_stats
+    from rt_lookdev.core import shading_ops as op
+    from rt_lookdev.core.ir import trace
+    from rt_lookdev.core.lut import catalog, exr_io
+
+    lut = op.Lut("ltc_ggx_inv", exr_io.read_table(lut_dir / catalog.TABLES["ltc_ggx_inv"].filename)[0])
+    _, outs = trace(lambda u, v: tuple(op.lut_sample(lut, u, v, c) for c in range(4)), {"u": "float", "v": "float"})
+    ng = build_node_group("RTL_lut", {f"c{c}": o for c, o in enumerate(outs)}, input_order=["u", "v"],
+                          lut_dir=lut_dir)
+    assert node_group_stats(ng)["ShaderNodeTexImage"] == 1       # one texture serves all four channels
+    assert len([i for i in bpy_images() if i.name.startswith("RTL_")]) == 1
+    rng = np.random.default_rng(11)
+    vals = {n: rng.uniform(-0.05, 1.05, (64, 64)).astype(np.float32) for n in ("u", "v")}
+    vals["u"][0, :4] = [0.5 / 64, 63.5 / 64, 0.0, 1.0]            # texel centres and the edges
+    for c, o in enumerate(outs):
+        _check(f"lut channel {c}", render_group_outputs(ng, vals, f"c{c}"), evaluate(o, vals))
+
+
+def bpy_images():
+    import bpy
+
+    return list(bpy.data.images)
