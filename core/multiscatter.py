@@ -1,7 +1,9 @@
 """Multiple-scattering compensation for GGX specular.
 
-Inputs come from the energy LUTs (core/lut): one_minus_e = 1 - E(mu, r), e_avg = E_avg(r),
-and the split-sum (scale, bias).  All take F90 = 1 unless given.
+Inputs come from the energy LUTs (core/lut): one_minus_e = 1 - E(mu, r),
+one_minus_e_avg = 1 - E_avg(r), and the split-sum (scale, bias).  The tables store 1 - E and
+1 - E_avg rather than E and E_avg because both tend to 1 at low roughness, where forming
+1 - E_avg in float32 would lose most digits (the lobe divides by it).  All take F90 = 1 unless given.
 """
 from __future__ import annotations
 
@@ -16,28 +18,28 @@ from .fresnel import fresnel_average
 ONE_MINUS_E_AVG_MIN = 1e-7
 
 
-def kulla_conty_lobe(one_minus_e_o, one_minus_e_i, e_avg):
+def kulla_conty_lobe(one_minus_e_o, one_minus_e_i, one_minus_e_avg):
     """Kulla-Conty multiple-scattering lobe for F = 1 (Kulla & Conty 2017, slide 18; the talk).
 
     f_ms(mu_o, mu_i) = (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg)).
     With E_avg = 2 int E mu dmu, int (f_ss + f_ms) mu_i dw_i = 1 for every mu_o.
     """
-    return one_minus_e_o * one_minus_e_i / (np.pi * op.maximum(1.0 - e_avg, ONE_MINUS_E_AVG_MIN))
+    return one_minus_e_o * one_minus_e_i / (np.pi * op.maximum(one_minus_e_avg, ONE_MINUS_E_AVG_MIN))
 
 
-def kulla_conty_fresnel_factor(f_avg, e_avg):
+def kulla_conty_fresnel_factor(f_avg, one_minus_e_avg):
     """Energy kept by the multiply-scattered paths with Fresnel F_avg per bounce.
 
     F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)) (Kulla & Conty 2017, slide 20; the talk).
     The denominator is >= E_avg > 0 for F_avg <= 1.
     """
-    return f_avg * f_avg * e_avg / op.maximum(1.0 - f_avg * (1.0 - e_avg), COS_EPS)
+    return f_avg * f_avg * (1.0 - one_minus_e_avg) / op.maximum(1.0 - f_avg * one_minus_e_avg, COS_EPS)
 
 
-def kulla_conty_brdf(one_minus_e_o, one_minus_e_i, e_avg, f0, f90=1.0):
+def kulla_conty_brdf(one_minus_e_o, one_minus_e_i, one_minus_e_avg, f0, f90=1.0):
     """Kulla-Conty lobe with Schlick's average Fresnel: F_ms(F_avg(F0), E_avg) * f_ms."""
-    return (kulla_conty_fresnel_factor(fresnel_average(f0, f90), e_avg)
-            * kulla_conty_lobe(one_minus_e_o, one_minus_e_i, e_avg))
+    return (kulla_conty_fresnel_factor(fresnel_average(f0, f90), one_minus_e_avg)
+            * kulla_conty_lobe(one_minus_e_o, one_minus_e_i, one_minus_e_avg))
 
 
 def turquin_compensation(f0, e_v):

@@ -30,7 +30,7 @@ def kulla_conty_ms_albedo(tables, mu_o, roughness, f0=1.0, n=8192):
     mu_i = (np.arange(n) + 0.5) / n
     r = np.full(n, float(roughness))
     f_ms = multiscatter.kulla_conty_brdf(tables.one_minus_e(np.array([mu_o]), r[:1]),
-                                         tables.one_minus_e(mu_i, r), tables.e_avg(r[:1]), f0)
+                                         tables.one_minus_e(mu_i, r), tables.one_minus_e_avg(r[:1]), f0)
     return 2.0 * np.pi * float(np.mean(f_ms * mu_i))
 
 
@@ -59,9 +59,9 @@ def talk_polynomial_furnace(raw_tables):
     ``raw_tables``: table name -> (H, W, 4) array (as read or baked).  The furnace uses E from
     the table and E_avg from the fit: E + (1 - E)(1 - E_avg_table)/(1 - E_avg_fit) - 1.
     """
-    size = raw_tables["ggx_E_avg"].shape[1]
+    size = raw_tables["ggx_one_minus_E_avg"].shape[1]
     nodes = np.arange(size) / (size - 1)
-    e_avg = raw_tables["ggx_E_avg"][0, :, 0].astype(np.float64)
+    e_avg = 1.0 - raw_tables["ggx_one_minus_E_avg"][0, :, 0].astype(np.float64)
     poly = multiscatter.average_energy_polynomial_talk(1.0 - nodes)
     diff = poly - e_avg
     worst = int(np.argmax(np.abs(diff)))

@@ -39,15 +39,15 @@ def compute_energy_tables(size, n_samples, progress=None):
     mu = table_nodes(size)
     scale, bias = energy.split_sum_terms(mu, r, n_samples, progress=progress)   # (r, mu)
     one_minus_e = (1.0 - (scale + bias)).T.astype(np.float32)                    # (mu, r)
-    # E_avg of exactly the function the stored table reconstructs (float32 values,
-    # piecewise linear in mu), so that the Kulla-Conty furnace identity holds to rounding.
-    e_stored = 1.0 - one_minus_e.astype(np.float64)
-    e_avg = energy.average_of_piecewise_linear(e_stored.T, mu)                  # (r,)
+    # 1 - E_avg of exactly the function the stored table reconstructs (float32 values, piecewise
+    # linear in mu), so that the Kulla-Conty furnace identity holds to rounding.  Since
+    # 2 int mu dmu = 1, 1 - E_avg = 2 int (1 - E) mu dmu: integrated directly, no cancellation.
+    one_minus_e_avg = energy.average_of_piecewise_linear(one_minus_e.astype(np.float64).T, mu)   # (r,)
     ones = np.ones((size, size), np.float32)
     zeros = np.zeros((size, size), np.float32)
     return {
         "ggx_one_minus_E": np.stack([one_minus_e, one_minus_e, one_minus_e, ones], axis=-1),
-        "ggx_E_avg": np.stack([e_avg, e_avg, e_avg, np.ones(size)], axis=-1)[None].astype(np.float32),
+        "ggx_one_minus_E_avg": np.stack([one_minus_e_avg] * 3 + [np.ones(size)], axis=-1)[None].astype(np.float32),
         "ggx_split_sum": np.stack([scale.T.astype(np.float32), bias.T.astype(np.float32), zeros, ones],
                                   axis=-1),
     }

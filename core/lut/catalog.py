@@ -19,8 +19,8 @@ from pathlib import Path
 
 from . import exr_io
 
-#: Bumped when the meaning or layout of any table changes.
-LAYOUT_VERSION = 1
+#: Bumped when the meaning or layout of any table changes (2: E_avg table stores 1 - E_avg).
+LAYOUT_VERSION = 2
 
 AXIS_U_ROUGHNESS = "u: Blender roughness r (GGX alpha = max(r^2, 1e-4)); node i at r = i/(W-1), texel centre (i+0.5)/W"
 AXIS_V_MU = ("v: mu = cos(theta_view); node j at mu = j/(H-1), texel centre (j+0.5)/H "
@@ -109,11 +109,11 @@ TABLES = {
             description="1 - directional albedo of single-scattering GGX with F = 1 "
                         "(height-correlated Smith G2); Kulla-Conty and Turquin input"),
         TableSpec(
-            name="ggx_E_avg", filename="ggx_E_avg.exr", group="ggx_energy",
+            name="ggx_one_minus_E_avg", filename="ggx_one_minus_E_avg.exr", group="ggx_energy",
             width=ENERGY_SIZE, height=1,
-            channels="R = G = B = E_avg(r); A = 1",
-            description="E_avg(r) = 2 int E(mu) mu dmu of the piecewise-linear E that ggx_one_minus_E "
-                        "reconstructs (exact furnace for the Kulla-Conty lobe)",
+            channels="R = G = B = 1 - E_avg(r); A = 1",
+            description="1 - E_avg(r), E_avg = 2 int E(mu) mu dmu of the piecewise-linear E that "
+                        "ggx_one_minus_E reconstructs (exact furnace for the Kulla-Conty lobe)",
             axis_v="v: none (one row; sample at v = 0.5)"),
         TableSpec(
             name="ggx_split_sum", filename="ggx_split_sum.exr", group="ggx_energy",

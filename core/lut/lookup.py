@@ -49,7 +49,7 @@ class EnergyTables:
     def __init__(self, lut_dir=None):
         lut_dir = Path(lut_dir) if lut_dir is not None else catalog.default_lut_dir()
         self.tables = {}
-        for name in ("ggx_one_minus_E", "ggx_E_avg", "ggx_split_sum"):
+        for name in ("ggx_one_minus_E", "ggx_one_minus_E_avg", "ggx_split_sum"):
             spec = catalog.TABLES[name]
             self.tables[name], _ = exr_io.read_table(lut_dir / spec.filename, spec.name, spec.shape)
 
@@ -60,9 +60,12 @@ class EnergyTables:
     def e(self, mu, roughness):
         return 1.0 - self.one_minus_e(mu, roughness)
 
-    def e_avg(self, roughness):
+    def one_minus_e_avg(self, roughness):
         u = lut_coordinate(roughness, catalog.ENERGY_SIZE)
-        return sample_bilinear(self.tables["ggx_E_avg"], u, np.full(np.shape(u), 0.5))[..., 0]
+        return sample_bilinear(self.tables["ggx_one_minus_E_avg"], u, np.full(np.shape(u), 0.5))[..., 0]
+
+    def e_avg(self, roughness):
+        return 1.0 - self.one_minus_e_avg(roughness)
 
     def split_sum(self, mu, roughness):
         """(scale, bias) at (mu, r)."""

@@ -216,6 +216,40 @@ def test_lut_lookup_matches(empty_scene, lut_dir):
         _check(f"lut channel {c}", render_group_outputs(ng, vals, f"c{c}"), evaluate(o, vals))
 
 
+def test_lut_driven_kulla_conty_lobe_matches(empty_scene, lut_dir):
+    """A technique that reads tables: the Kulla-Conty lobe from the energy LUTs, in nodes."""
+    from rt_lookdev.addon.node_emit import build_node_group, node_group_stats
+    from rt_lookdev.core import multiscatter
+    from rt_lookdev.core import shading_ops as op
+    from rt_lookdev.core.ir import trace
+    from rt_lookdev.core.lut import catalog, exr_io
+    from rt_lookdev.core.lut.lookup import lut_coordinate
+
+    luts = {name: op.Lut(name, exr_io.read_table(lut_dir / catalog.TABLES[name].filename)[0])
+            for name in ("ggx_one_minus_E", "ggx_one_minus_E_avg")}
+
+    def lobe(mu_o, mu_i, r, f0):
+        u = lut_coordinate(r, catalog.ENERGY_SIZE)
+        one_minus_e_o = op.lut_sample(luts["ggx_one_minus_E"], u, lut_coordinate(mu_o, catalog.ENERGY_SIZE), 0)
+        one_minus_e_i = op.lut_sample(luts["ggx_one_minus_E"], u, lut_coordinate(mu_i, catalog.ENERGY_SIZE), 0)
+        one_minus_e_avg = op.lut_sample(luts["ggx_one_minus_E_avg"], u, 0.5, 0)
+        return multiscatter.kulla_conty_brdf(one_minus_e_o, one_minus_e_i, one_minus_e_avg, f0)
+
+    names = ["mu_o", "mu_i", "r", "f0"]
+    _, out = trace(lobe, dict.fromkeys(names, "float"))
+    ng = build_node_group("RTL_kc_lut", {"out": out}, input_order=names, lut_dir=lut_dir)
+    assert node_group_stats(ng)["ShaderNodeTexImage"] == 3       # (1-E, mu_o), (1-E, mu_i), (1-E_avg)
+    rng = np.random.default_rng(11)
+    vals = {n: rng.random((64, 64)).astype(np.float32) for n in names}
+    vals["r"][0, :6] = [0.0, 1.0, 1 / 63, 0.5, 1e-4, 1 - 1e-4]
+    got = render_group_outputs(ng, vals, "out")
+    direct = lobe(**{k: v.astype(np.float64) for k, v in vals.items()})   # numpy, no IR
+    assert np.allclose(evaluate(out, vals, dtype=np.float64), direct, rtol=1e-6, atol=1e-12)
+    _check("kulla_conty_lut", got, evaluate(out, vals))
+    # with 1 - E_avg stored, float32 (Cycles) also agrees with float64 numpy
+    assert np.allclose(got, direct, rtol=1e-4, atol=1e-7)
+
+
 def bpy_images():
     import bpy
 

@@ -82,7 +82,7 @@ def _ggx(mu_l, mu_v, n_dot_h, v_dot_h, r, f0):
 TECHNIQUES = {
     "ggx_brdf": (_ggx, ["mu_l", "mu_v", "n_dot_h", "v_dot_h", "r", "f0"]),
     "fresnel_average": (lambda f0: fresnel.fresnel_average(f0), ["f0"]),
-    "kulla_conty_brdf": (multiscatter.kulla_conty_brdf, ["one_minus_e_o", "one_minus_e_i", "e_avg", "f0"]),
+    "kulla_conty_brdf": (multiscatter.kulla_conty_brdf, ["one_minus_e_o", "one_minus_e_i", "one_minus_e_avg", "f0"]),
     "turquin": (multiscatter.turquin_compensation, ["f0", "e_v"]),
     "fdez_aguera": (multiscatter.fdez_aguera_env_brdf, ["f0", "scale", "bias"]),
     "fdez_aguera_area": (multiscatter.fdez_aguera_area_scale, ["f0", "e"]),
@@ -112,8 +112,8 @@ def _inputs(names, n=4000, seed=0):
             x = np.abs(x) * 5
         if name in ("inner_angle", "outer_angle"):
             x = np.abs(x) * 3.0
-        if name == "e_avg":          # the table's range (0.409 at r = 1); 1 - E_avg is a float32 difference
-            x = np.clip(x, 0.4, 0.999)
+        if name == "one_minus_e_avg":    # the table's range: 1.3e-5 (r = 0) .. 0.59 (r = 1)
+            x = np.clip(x, 1e-5, 0.6)
         vals[name] = x
     return vals
 

@@ -69,8 +69,8 @@ def test_missing_corrupt_and_mismatched_files(tmp_path, lut_dir):
     truncated.write_bytes((Path(lut_dir) / spec.filename).read_bytes()[:600])
     with pytest.raises(exr_io.LutCorruptError):
         exr_io.read_table(truncated, spec.name, spec.shape)
-    with pytest.raises(exr_io.LutMismatchError, match="ggx_E_avg"):
-        exr_io.read_table(Path(lut_dir) / "ggx_E_avg.exr", spec.name, spec.shape)
+    with pytest.raises(exr_io.LutMismatchError, match="ggx_one_minus_E_avg"):
+        exr_io.read_table(Path(lut_dir) / "ggx_one_minus_E_avg.exr", spec.name, spec.shape)
     with pytest.raises(exr_io.LutMismatchError, match="64x64"):
         exr_io.read_table(Path(lut_dir) / spec.filename, spec.name, (32, 32))
     foreign = tmp_path / "foreign.exr"
@@ -120,16 +120,16 @@ def test_bake_cache_hit_and_miss(tmp_path, fast_energy_group, monkeypatch):
     assert [r.state for r in second] == ["cached"] and "nothing to do" in lines[-1]
     assert {p: p.stat().st_mtime_ns for p in tmp_path.glob("*.exr")} == mtimes
     assert all(catalog.table_status(catalog.TABLES[n], tmp_path).state == "ok"
-               for n in ("ggx_one_minus_E", "ggx_E_avg", "ggx_split_sum"))
+               for n in ("ggx_one_minus_E", "ggx_one_minus_E_avg", "ggx_split_sum"))
     # a changed input makes the files stale and the next bake redoes them
     changed = catalog.BakeGroup("ggx_energy", 1, dict(fast_energy_group.params, samples=32), fast_energy_group.sources)
     monkeypatch.setitem(catalog.GROUPS, "ggx_energy", changed)
     assert {catalog.table_status(catalog.TABLES[n], tmp_path).state
-            for n in ("ggx_one_minus_E", "ggx_E_avg", "ggx_split_sum")} == {"stale"}
+            for n in ("ggx_one_minus_E", "ggx_one_minus_E_avg", "ggx_split_sum")} == {"stale"}
     assert [r.state for r in bake.bake(tmp_path, log=lines.append, groups=["ggx_energy"])] == ["baked"]
     # a damaged file is re-baked too
-    (tmp_path / "ggx_E_avg.exr").write_bytes(b"junk")
-    assert catalog.table_status(catalog.TABLES["ggx_E_avg"], tmp_path).state == "corrupt"
+    (tmp_path / "ggx_one_minus_E_avg.exr").write_bytes(b"junk")
+    assert catalog.table_status(catalog.TABLES["ggx_one_minus_E_avg"], tmp_path).state == "corrupt"
     assert [r.state for r in bake.bake(tmp_path, log=lines.append, groups=["ggx_energy"])] == ["baked"]
 
 

@@ -19,8 +19,8 @@ def test_ms_albedo_quadrature_on_a_constant_lobe():
         def one_minus_e(self, mu, r):
             return np.full(np.shape(mu), 0.3)
 
-        def e_avg(self, r):
-            return np.full(np.shape(r), 0.7)
+        def one_minus_e_avg(self, r):
+            return np.full(np.shape(r), 0.3)
 
     assert validation.kulla_conty_ms_albedo(Constant(), 0.5, 0.5) == pytest.approx(0.3, rel=1e-9)
 
@@ -41,19 +41,19 @@ def test_table_e_avg_matches_reference(energy_tables):
 
 
 def test_kulla_conty_fresnel_factor_limits():
-    e_avg = np.linspace(0.4, 1.0, 7)
-    assert np.allclose(multiscatter.kulla_conty_fresnel_factor(1.0, e_avg), 1.0)
-    assert np.allclose(multiscatter.kulla_conty_fresnel_factor(0.0, e_avg), 0.0)
-    # colour saturation: F_ms grows faster than F_avg at low E_avg
-    assert multiscatter.kulla_conty_fresnel_factor(0.5, 0.4) < 0.5 * 0.5 / 0.4
+    one_minus_e_avg = 1.0 - np.linspace(0.4, 1.0, 7)
+    assert np.allclose(multiscatter.kulla_conty_fresnel_factor(1.0, one_minus_e_avg), 1.0)
+    assert np.allclose(multiscatter.kulla_conty_fresnel_factor(0.0, one_minus_e_avg), 0.0)
+    # F_ms = F^2 E / (1 - F (1 - E)) at F = 0.5, E_avg = 0.4
+    assert multiscatter.kulla_conty_fresnel_factor(0.5, 0.6) == pytest.approx(0.25 * 0.4 / 0.7)
 
 
 def test_kulla_conty_lobe_is_reciprocal(energy_tables):
     rng = np.random.default_rng(3)
     mu_a, mu_b, r = rng.random((3, 500))
-    e_avg = energy_tables.e_avg(r)
-    a = multiscatter.kulla_conty_brdf(energy_tables.one_minus_e(mu_a, r), energy_tables.one_minus_e(mu_b, r), e_avg, 0.5)
-    b = multiscatter.kulla_conty_brdf(energy_tables.one_minus_e(mu_b, r), energy_tables.one_minus_e(mu_a, r), e_avg, 0.5)
+    one_minus_e_avg = energy_tables.one_minus_e_avg(r)
+    a = multiscatter.kulla_conty_brdf(energy_tables.one_minus_e(mu_a, r), energy_tables.one_minus_e(mu_b, r), one_minus_e_avg, 0.5)
+    b = multiscatter.kulla_conty_brdf(energy_tables.one_minus_e(mu_b, r), energy_tables.one_minus_e(mu_a, r), one_minus_e_avg, 0.5)
     assert np.array_equal(a, b)
 
 
