@@ -378,7 +378,9 @@ def _tables(lut_dir):
             lut_dir = catalog.default_lut_dir()
         else:
             lut_dir = Path(tempfile.mkdtemp(prefix="rtl-luts-"))
-    bake.bake(lut_dir)    # no-op when current
+    # only the energy tables are read here; a no-op when they are current (the main job has
+    # checked them already), so only actual baking is reported
+    bake.bake(lut_dir, groups=["ggx_energy"], log=lambda line: "nothing to do" in line or print(line))
     return EnergyTables(lut_dir), str(lut_dir)
 
 
