@@ -115,8 +115,8 @@ def _orthonormal(n):
 def random_lights(kind, count, lobe_name, seed):
     """Seeded random configurations: (r, theta_v, light geometry in the local frame).
 
-    Half the lights are aimed near the lobe's peak (mirror direction for GGX and cloth's
-    opposite side alike: within 60 deg of it), half anywhere above -15 deg elevation; distance
+    Half the lights are aimed within 60 deg of the lobe's peak (the mirror direction for GGX,
+    the normal for the other lobes), half anywhere above -15 deg elevation; distance
     1..4, quads 0.3..3 per side, disk radius 0.15..1.5, facing the point within 45 deg.
     """
     rng = np.random.default_rng(seed)
