@@ -22,6 +22,7 @@ MATH_OPS = {
     "log2": "LOGARITHM", "minimum": "MINIMUM", "maximum": "MAXIMUM", "less_than": "LESS_THAN",
     "greater_than": "GREATER_THAN", "absolute": "ABSOLUTE", "arccosine": "ARCCOSINE",
     "arcsine": "ARCSINE", "sine": "SINE", "cosine": "COSINE", "tangent": "TANGENT",
+    "arctan2": "ARCTAN2",
 }
 
 #: IR operation -> (ShaderNodeVectorMath.operation, input socket indices, output socket name)
@@ -29,6 +30,7 @@ VECTOR_OPS = {
     "vadd": ("ADD", (0, 1), "Vector"),
     "vsubtract": ("SUBTRACT", (0, 1), "Vector"),
     "vscale": ("SCALE", (0, 3), "Vector"),          # input 3 is 'Scale'
+    "vmultiply": ("MULTIPLY", (0, 1), "Vector"),
     "dot": ("DOT_PRODUCT", (0, 1), "Value"),
     "cross": ("CROSS_PRODUCT", (0, 1), "Vector"),
     "length": ("LENGTH", (0,), "Value"),

@@ -189,6 +189,19 @@ def cos(a):
     return np.cos(_arr(a))
 
 
+def atan2(y, x):
+    """Angle of (x, y) in [-pi, pi] (Math "Arctan2": atan2(first input, second input))."""
+    if is_expr(y, x):
+        return _node("arctan2", y, x)
+    return np.arctan2(_arr(y), _arr(x))
+
+
+def absolute(a):
+    if is_expr(a):
+        return _node("absolute", a)
+    return np.abs(_arr(a))
+
+
 def tan(a):
     if is_expr(a):
         return _node("tangent", a)
@@ -232,6 +245,33 @@ def length(v):
     if is_expr(v):
         return _node("length", v)
     return np.sqrt(dot(v, v))
+
+
+def component(v, axis):
+    """Component 0/1/2 (x/y/z) of a vector (a Separate XYZ output in nodes)."""
+    if is_expr(v):
+        return _node("xyz"[axis], v)
+    return _arr(v)[..., axis]
+
+
+def vec3(x, y, z):
+    """A vector from three scalars (Combine XYZ)."""
+    if is_expr(x, y, z):
+        g = graph_of(x, y, z)
+        return g.make("combine", (x, y, z))
+    return np.stack(np.broadcast_arrays(_arr(x), _arr(y), _arr(z)), axis=-1)
+
+
+def vmul(a, b):
+    """Component-wise product of two vectors (Vector Math "Multiply"), e.g. colour times colour."""
+    if is_expr(a, b):
+        return _node("vmultiply", a, b)
+    return _arr(a) * _arr(b)
+
+
+def mat_vec(rows, x):
+    """A 3x3 matrix given as its three row vectors, applied to a vector: three dot products."""
+    return vec3(dot(rows[0], x), dot(rows[1], x), dot(rows[2], x))
 
 
 def scale(v, s):

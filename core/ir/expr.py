@@ -19,6 +19,7 @@ import threading
 import numpy as np
 
 FLOAT, VECTOR = "float", "vector"
+CALL = "call"   # the kind of a function-call node; its outputs are "output" nodes
 
 #: operation -> (argument kinds, result kind).  "vector?"-free: every operation has fixed kinds.
 OPS = {
@@ -32,6 +33,7 @@ OPS = {
     "less_than": ((FLOAT, FLOAT), FLOAT), "greater_than": ((FLOAT, FLOAT), FLOAT),
     "absolute": ((FLOAT,), FLOAT), "arccosine": ((FLOAT,), FLOAT), "arcsine": ((FLOAT,), FLOAT),
     "sine": ((FLOAT,), FLOAT), "cosine": ((FLOAT,), FLOAT), "tangent": ((FLOAT,), FLOAT),
+    "arctan2": ((FLOAT, FLOAT), FLOAT),
     # Mix node with a float factor: select(c, a, b) = mix(b, a, c) for c in {0, 1}
     "select": ((FLOAT, FLOAT, FLOAT), FLOAT),
     "vselect": ((FLOAT, VECTOR, VECTOR), VECTOR),
@@ -42,7 +44,8 @@ OPS = {
     "z": ((VECTOR,), FLOAT),
     # Vector Math node (ShaderNodeVectorMath)
     "vadd": ((VECTOR, VECTOR), VECTOR), "vsubtract": ((VECTOR, VECTOR), VECTOR),
-    "vscale": ((VECTOR, FLOAT), VECTOR), "dot": ((VECTOR, VECTOR), FLOAT),
+    "vscale": ((VECTOR, FLOAT), VECTOR), "vmultiply": ((VECTOR, VECTOR), VECTOR),
+    "dot": ((VECTOR, VECTOR), FLOAT),
     "cross": ((VECTOR, VECTOR), VECTOR), "length": ((VECTOR,), FLOAT), "normalize": ((VECTOR,), VECTOR),
 }
 
@@ -55,7 +58,41 @@ class Graph:
     def __init__(self):
         self.nodes = {}
         self.luts = {}          # table name -> (H, W, 4) array, for the numpy backend
+        self.functions = {}     # Function.key -> Function called from this graph
         self._ids = itertools.count()
+
+    def call(self, function, args):
+        """Outputs (dict name -> Expr) of ``function`` applied to ``args`` (dict input name -> value).
+
+        A call is one node of this graph (a Group node in Blender); the function's own graph is
+        shared by every call, in any graph.  Outputs that the function folded to constants are
+        returned as constants here."""
+        missing = [n for n, _ in function.inputs if n not in args]
+        extra = set(args) - {n for n, _ in function.inputs}
+        if missing or extra:
+            raise ValueError(f"call of {function.name}: missing {missing}, unknown {sorted(extra)}")
+        lifted = tuple(self.lift(args[n]) for n, _ in function.inputs)
+        for (n, kind), a in zip(function.inputs, lifted):
+            if a.kind != kind:
+                raise TypeError(f"call of {function.name}: input {n!r} is {kind}, got {a.kind}")
+        self.functions[function.key] = function
+        key = ("call", tuple(a.id for a in lifted), (("function", function.key),))
+        node = self.nodes.get(key)
+        if node is None:
+            node = Expr(self, next(self._ids), "call", lifted, key[2], CALL)
+            self.nodes[key] = node
+        results = {}
+        for name, out in function.outputs.items():
+            if out.is_const:
+                results[name] = self.const(out.attr("value")) if out.kind == FLOAT else self.vconst(out.attr("value"))
+                continue
+            okey = ("output", (node.id,), (("name", name),))
+            onode = self.nodes.get(okey)
+            if onode is None:
+                onode = Expr(self, next(self._ids), "output", (node,), okey[2], out.kind)
+                self.nodes[okey] = onode
+            results[name] = onode
+        return results
 
     def make(self, op, args=(), attrs=()):
         if op not in OPS:
@@ -169,6 +206,54 @@ def trace(fn, inputs, graph=None):
     graph = graph or Graph()
     args = {name: graph.input(name, kind) for name, kind in inputs.items()}
     return graph, fn(**args)
+
+
+class Function:
+    """A traced function: named, typed inputs and outputs over one Graph of its own.
+
+    Backends treat a call as a unit: numpy evaluates the function's graph, the node backend
+    emits it once as a node group and instances it at every call (nesting keeps every emitted
+    tree small, and a function shared by lights, lobes or materials is built once).  ``key`` is
+    a hash of the graph's structure, so two traces of the same math have the same key.
+    """
+
+    def __init__(self, name, inputs, outputs, description="", sockets=None):
+        self.name, self.description = name, description
+        self.inputs = list(inputs.items())
+        self.outputs = dict(outputs)
+        self.sockets = dict(sockets or {})      # input/output name -> core.ir.interface.Socket
+        graphs = {e.graph for e in self.outputs.values() if isinstance(e, Expr)}
+        if len(graphs) != 1:
+            raise ValueError(f"{name}: outputs must be expressions of one graph")
+        self.graph = graphs.pop()
+        self.key = _structure_hash(self)
+
+    def __repr__(self):
+        return f"Function<{self.name} {self.key[:8]}>"
+
+
+def define(name, fn, inputs, description="", sockets=None):
+    """Trace ``fn`` (keyword arguments named as ``inputs``, name -> kind) into a Function; ``fn``
+    returns a dict of output name -> Expr (or value)."""
+    graph, out = trace(fn, inputs)
+    if not isinstance(out, dict):
+        raise TypeError(f"{name}: a function must return a dict of named outputs")
+    out = {k: graph.lift(v) for k, v in out.items()}
+    return Function(name, inputs, out, description, sockets)
+
+
+def _structure_hash(function):
+    import hashlib
+
+    from .numpy_backend import topological_order
+
+    index = {}
+    parts = [repr(function.inputs), repr([(k, e.kind) for k, e in function.outputs.items()])]
+    for node in topological_order(list(function.outputs.values())):
+        index[node.id] = len(index)
+        parts.append(repr((node.op, node.attrs, tuple(index[a.id] for a in node.args))))
+    parts.append(repr([index[e.id] for e in function.outputs.values()]))
+    return hashlib.sha1("\n".join(parts).encode()).hexdigest()
 
 
 # --- folding -----------------------------------------------------------------------------------

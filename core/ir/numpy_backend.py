@@ -64,6 +64,7 @@ _SCALAR = {
     "sine": np.sin,
     "cosine": np.cos,
     "tangent": np.tan,
+    "arctan2": np.arctan2,
     "select": lambda c, a, b: np.where(c != 0, a, b),
     "vselect": lambda c, a, b: np.where((c != 0)[..., None], a, b),
     "combine": lambda x, y, z: np.stack(np.broadcast_arrays(x, y, z), axis=-1),
@@ -73,6 +74,7 @@ _SCALAR = {
     "vadd": lambda a, b: a + b,
     "vsubtract": lambda a, b: a - b,
     "vscale": lambda v, s: v * s[..., None],
+    "vmultiply": lambda a, b: a * b,
     "dot": _dot,
     "cross": lambda a, b: np.cross(*np.broadcast_arrays(a, b)),
     "length": lambda v: np.sqrt(_dot(v, v)),
@@ -99,6 +101,14 @@ def evaluate(outputs, inputs, dtype=np.float32):
             cache[node.id] = np.asarray(node.attr("value"), dtype=dtype)
         elif node.op in ("input", "vinput"):
             cache[node.id] = np.asarray(inputs[node.attr("name")], dtype=dtype)
+        elif node.op == "call":
+            fn = node.graph.functions[node.attr("function")]
+            args = {name: cache[a.id] for (name, _), a in zip(fn.inputs, node.args)}
+            names = list(fn.outputs)
+            values = evaluate(tuple(fn.outputs[n] for n in names), args, dtype)
+            cache[node.id] = dict(zip(names, values))
+        elif node.op == "output":
+            cache[node.id] = cache[node.args[0].id][node.attr("name")]
         elif node.op == "lut":
             from ..lut.lookup import sample_bilinear
 
@@ -129,6 +139,20 @@ def topological_order(outputs):
 
 
 def node_count(outputs):
-    """Operations (excluding inputs and constants) a graph needs: what a node group would hold."""
+    """Operations (excluding inputs and constants) a graph needs: what a node group would hold
+    (a function call counts once, as its Group node; its outputs count nothing)."""
     outs = (outputs,) if isinstance(outputs, Expr) else tuple(outputs)
-    return sum(1 for n in topological_order(outs) if n.op not in ("const", "vconst", "input", "vinput"))
+    return sum(1 for n in topological_order(outs) if n.op not in ("const", "vconst", "input", "vinput", "output"))
+
+
+def flat_node_count(outputs):
+    """Operations with every function call expanded (what one flat tree would hold)."""
+    outs = (outputs,) if isinstance(outputs, Expr) else tuple(outputs)
+    total = 0
+    for n in topological_order(outs):
+        if n.op == "call":
+            fn = n.graph.functions[n.attr("function")]
+            total += flat_node_count(tuple(fn.outputs.values()))
+        elif n.op not in ("const", "vconst", "input", "vinput", "output"):
+            total += 1
+    return total

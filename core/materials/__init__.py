@@ -1,0 +1,1 @@
+"""Lookdev materials composed from the shading techniques (pure Python; no bpy)."""

@@ -1,0 +1,71 @@
+"""The RT Lit material's interface: its inputs (Principled-like) and its build-time switches.
+
+Inputs are node-group sockets an artist sets or links; switches (``Features``) choose which
+techniques the group is built with, so a disabled technique carries no nodes at all (the
+switch is folded away at build time, not multiplied by zero at render time).
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+from ..ir.interface import Socket, color, factor, scalar, vector
+
+SPECULAR_MODELS = ("single", "turquin", "fdez_aguera", "kulla_conty")
+DIFFUSE_MODELS = ("lambert", "cod", "wrapped")
+
+#: Input name -> socket, in interface order.  Names follow the Principled BSDF where one exists,
+#: so a conversion maps them one to one.
+RT_LIT_INPUTS = {
+    "Base Color": color((0.8, 0.8, 0.8, 1.0), "Diffuse albedo (dielectric) or F0 (metal)", "Surface"),
+    "Metallic": factor(0.0, "Blend from dielectric to metal", "Surface"),
+    "Roughness": factor(0.5, "Blender roughness r; GGX alpha = r^2", "Surface"),
+    "IOR": scalar(1.5, "Index of refraction of the dielectric: F0 = ((IOR - 1)/(IOR + 1))^2", 1.0, 4.0,
+                  panel="Specular"),
+    "Specular IOR Level": factor(0.5, "Scales the dielectric F0 by 2 x level (0.5 keeps it), as Principled",
+                                 "Specular"),
+    "Specular Tint": color((1.0, 1.0, 1.0, 1.0), "Tint of the dielectric F0", "Specular"),
+    "Wrap": factor(0.0, "Wrapped-diffuse amount w (used when the diffuse model is 'wrapped')", "Diffuse"),
+    "Sheen Weight": factor(0.0, "Disney sheen amount (used when sheen is switched on)", "Sheen"),
+    "Sheen Tint": color((1.0, 1.0, 1.0, 1.0), "Colour of the Disney sheen", "Sheen"),
+    "Cloth Weight": factor(0.0, "Blend from the specular lobe to the Ashikhmin cloth lobe (cloth switched on)",
+                           "Cloth"),
+    "Cloth Color": color((1.0, 1.0, 1.0, 1.0), "Colour of the cloth lobe", "Cloth"),
+    "Emission Color": color((1.0, 1.0, 1.0, 1.0), "Emitted radiance colour, added to the shaded result",
+                            "Emission"),
+    "Emission Strength": scalar(0.0, "Emitted radiance strength", 0.0, None, panel="Emission"),
+    "Normal": vector("Shading normal (world space); unlinked = the geometry's normal", "NONE",
+                     hide_value=True),
+}
+
+#: Output name -> socket.
+RT_LIT_OUTPUTS = {
+    "Radiance": Socket("color", (0.0, 0.0, 0.0, 1.0), description="Outgoing radiance towards the camera"),
+}
+
+
+@dataclass(frozen=True)
+class Features:
+    """Build-time switches of an RT Lit group."""
+    specular: str = "turquin"        # one of SPECULAR_MODELS
+    diffuse: str = "cod"             # one of DIFFUSE_MODELS
+    sheen: bool = False
+    cloth: bool = False
+
+    def __post_init__(self):
+        if self.specular not in SPECULAR_MODELS:
+            raise ValueError(f"specular model must be one of {SPECULAR_MODELS}, got {self.specular!r}")
+        if self.diffuse not in DIFFUSE_MODELS:
+            raise ValueError(f"diffuse model must be one of {DIFFUSE_MODELS}, got {self.diffuse!r}")
+
+    def as_dict(self):
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data):
+        names = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in dict(data).items() if k in names})
+
+    def label(self):
+        parts = [self.specular.replace("_", "-"), self.diffuse]
+        parts += [p for p, on in (("sheen", self.sheen), ("cloth", self.cloth)) if on]
+        return ", ".join(parts)
