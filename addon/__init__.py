@@ -6,11 +6,13 @@ tuple (in order) and unregisters them in reverse.  Registration does no file I/O
 """
 import bpy
 
-from . import operators, preferences
+from . import convert, operators, preferences, ui
 
 classes = (
     *operators.classes,
+    *convert.classes,
     *preferences.classes,
+    *ui.classes,
 )
 
 

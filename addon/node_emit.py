@@ -81,152 +81,321 @@ def _depths(order):
     return depth
 
 
+#: Bump when the emitter's output for an unchanged IR changes (layout aside): stamps include it.
+EMITTER_VERSION = 2
+
+#: Soft cap on nodes per emitted tree (../shared/reference/blender_addon.md §2.3: flat trees build
+#: super-linearly; nested groups of <= ~150 nodes build ~50x faster with identical pixels).
+MAX_GROUP_NODES = 150
+
+_SOCKET_TYPES = {"float": "NodeSocketFloat", "vector": "NodeSocketVector", "color": "NodeSocketColor",
+                 FLOAT: "NodeSocketFloat", VECTOR: "NodeSocketVector"}
+
+
+def _socket_value(socket, value):
+    """A default value shaped for ``socket`` (colours take RGBA)."""
+    if isinstance(value, (tuple, list)) and getattr(socket, "type", "") == "RGBA" and len(value) == 3:
+        return (*value, 1.0)
+    if isinstance(value, (tuple, list)) and getattr(socket, "type", "") in ("VALUE",) and len(value) >= 3:
+        return sum(value[:3]) / 3.0
+    return value
+
+
+def _new_interface_socket(iface, name, in_out, kind, spec, panels):
+    """An interface socket from a core.ir.interface.Socket (or just a kind)."""
+    socket_kind = spec.kind if spec is not None else kind
+    parent = None
+    if spec is not None and spec.panel:
+        parent = panels.get(spec.panel)
+        if parent is None:
+            parent = panels[spec.panel] = iface.new_panel(spec.panel, default_closed=False)
+    item = iface.new_socket(name, in_out=in_out, socket_type=_SOCKET_TYPES[socket_kind], parent=parent)
+    if spec is None:
+        return item
+    item.description = spec.description
+    if spec.subtype and spec.subtype != "NONE":
+        item.subtype = spec.subtype
+    if in_out == "INPUT":
+        default = spec.default
+        if socket_kind == "color" and len(default) == 3:
+            default = (*default, 1.0)
+        item.default_value = default
+        if spec.min is not None and hasattr(item, "min_value"):
+            item.min_value = spec.min
+        if spec.max is not None and hasattr(item, "max_value"):
+            item.max_value = spec.max
+        item.hide_value = spec.hide_value
+    return item
+
+
+class _Emitter:
+    """Materialises IR graphs as node trees; shares one group per function (by structure key)."""
+
+    def __init__(self, lut_dir=None):
+        self.lut_dir = lut_dir
+        self.groups = {}          # Function.key -> node tree ensured in this build
+
+    # -- functions ---------------------------------------------------------------------------
+    def function_group(self, fn):
+        ng = self.groups.get(fn.key)
+        if ng is not None:
+            return ng
+        stamp = f"{EMITTER_VERSION}:{fn.key}"
+        ng = bpy.data.node_groups.get(fn.name)
+        if ng is None or ng.bl_idname != "ShaderNodeTree":
+            ng = bpy.data.node_groups.new(fn.name, "ShaderNodeTree")
+        elif ng.get("rtl_stamp") == stamp:
+            self._ensure_nested(fn)
+            self.groups[fn.key] = ng
+            return ng
+        else:
+            ng.nodes.clear()
+            ng.interface.clear()
+        self.fill(ng, fn.outputs, [n for n, _ in fn.inputs], fn.sockets,
+                  {n: k for n, k in fn.inputs}, description=fn.description)
+        ng["rtl_stamp"] = stamp
+        ng["rtl_function"] = fn.name
+        self.groups[fn.key] = ng
+        return ng
+
+    def _ensure_nested(self, fn):
+        """A stamped group is current; its nested functions are current too (same key), but a
+        nested group may have been deleted or renamed by the user: re-ensure them."""
+        for node in topological_order(list(fn.outputs.values())):
+            if node.op == "call":
+                self.function_group(node.graph.functions[node.attr("function")])
+
+    # -- one tree ----------------------------------------------------------------------------
+    def fill(self, ng, outputs, input_names, sockets=None, kinds=None, internal_inputs=None, description=""):
+        """Emit ``outputs`` (name -> Expr of one graph) into the empty tree ``ng``.
+
+        ``input_names``: interface inputs, in order; ``sockets``: name -> interface.Socket for
+        inputs and outputs; ``internal_inputs``: graph input name -> callable(nodes, links) giving
+        an output socket inside the tree (e.g. Geometry > Position) instead of an interface input.
+        """
+        sockets, kinds, internal_inputs = sockets or {}, kinds or {}, internal_inputs or {}
+        outs = list(outputs.items())
+        graph = next((e.graph for _, e in outs if isinstance(e, Expr)), None)
+        if graph is None or any(not isinstance(e, Expr) or e.graph is not graph for _, e in outs):
+            raise ValueError("all outputs must be expressions of one graph")
+        order = topological_order([e for _, e in outs])
+        depth = _depths(order)
+        inputs = {n.attr("name"): n for n in order if n.op in ("input", "vinput")}
+        missing = set(inputs) - set(input_names) - set(internal_inputs)
+        if missing:
+            raise ValueError(f"inputs lack graph inputs {sorted(missing)}")
+
+        ng.description = description
+        iface = ng.interface
+        panels = {}
+        for out_name, expr in outs:
+            _new_interface_socket(iface, out_name, "OUTPUT", expr.kind, sockets.get(out_name), panels)
+        in_items = {}
+        for n in input_names:
+            kind = inputs[n].kind if n in inputs else kinds.get(n, FLOAT)
+            in_items[n] = _new_interface_socket(iface, n, "INPUT", kind, sockets.get(n), panels)
+
+        nodes, links = ng.nodes, ng.links
+        max_depth = max(depth.values()) if depth else 0
+        column_rows = Counter()
+
+        def place(node, col, label):
+            row = column_rows[col]
+            column_rows[col] += 1
+            node.location = (col * COLUMN_WIDTH, -row * ROW_HEIGHT)
+            node.label = label
+
+        group_in = nodes.new("NodeGroupInput")
+        place(group_in, 0, "inputs")
+        group_in.width = 140
+
+        produced = {}
+        for n, item in in_items.items():
+            if n in inputs:
+                produced[inputs[n].id] = _socket(group_in.outputs, item.identifier)
+        for n, make_socket in internal_inputs.items():
+            if n in inputs:
+                produced[inputs[n].id] = make_socket(nodes, links)
+        separators = {}       # source vector id -> ShaderNodeSeparateXYZ
+        textures = {}         # (table, u id, v id) -> (Image Texture node, Separate Color node)
+        calls = {}            # call node id -> Group node
+
+        def feed(socket, arg):
+            if arg.is_const:
+                socket.default_value = _socket_value(socket, arg.attr("value"))
+            else:
+                links.new(produced[arg.id], socket)
+
+        for node in order:
+            op = node.op
+            if op in _LEAVES:
+                continue
+            col = depth[node.id]
+            if op in MATH_OPS:
+                bn = nodes.new("ShaderNodeMath")
+                bn.operation = MATH_OPS[op]
+                bn.use_clamp = False
+                for i, a in enumerate(node.args):
+                    feed(bn.inputs[i], a)
+                if op == "log2":
+                    bn.inputs[1].default_value = 2.0
+                produced[node.id] = bn.outputs[0]
+            elif op in MIX_SOCKETS:
+                fac, a_id, b_id, res = MIX_SOCKETS[op]
+                bn = nodes.new("ShaderNodeMix")
+                bn.data_type = "FLOAT" if op == "select" else "VECTOR"
+                if op == "vselect":
+                    bn.factor_mode = "UNIFORM"
+                cond, if_true, if_false = node.args
+                feed(_socket(bn.inputs, fac), cond)
+                feed(_socket(bn.inputs, a_id), if_false)
+                feed(_socket(bn.inputs, b_id), if_true)
+                produced[node.id] = _socket(bn.outputs, res)
+            elif op == "combine":
+                bn = nodes.new("ShaderNodeCombineXYZ")
+                for i, a in enumerate(node.args):
+                    feed(bn.inputs[i], a)
+                produced[node.id] = bn.outputs[0]
+            elif op in _COMPONENTS:
+                src = node.args[0]
+                bn = separators.get(src.id)
+                if bn is None:
+                    bn = nodes.new("ShaderNodeSeparateXYZ")
+                    feed(bn.inputs[0], src)
+                    separators[src.id] = bn
+                    place(bn, col, "separate")
+                produced[node.id] = bn.outputs[_COMPONENTS[op]]
+                continue
+            elif op == "lut":
+                table, channel = node.attr("table"), node.attr("channel")
+                u, v = node.args
+                key = (table, u.id, v.id)
+                if key not in textures:
+                    uv = nodes.new("ShaderNodeCombineXYZ")
+                    feed(uv.inputs[0], u)
+                    feed(uv.inputs[1], v)
+                    place(uv, col, "lut uv")
+                    tex = nodes.new("ShaderNodeTexImage")
+                    tex.image = lut_image(table, self.lut_dir)
+                    tex.interpolation = "Linear"
+                    tex.extension = "EXTEND"
+                    links.new(uv.outputs[0], tex.inputs["Vector"])
+                    place(tex, col, table)
+                    sep = nodes.new("ShaderNodeSeparateColor")
+                    links.new(tex.outputs["Color"], sep.inputs[0])
+                    place(sep, col, "channels")
+                    textures[key] = (tex, sep)
+                tex, sep = textures[key]
+                produced[node.id] = tex.outputs["Alpha"] if channel == 3 else sep.outputs[channel]
+                continue
+            elif op == "call":
+                fn = node.graph.functions[node.attr("function")]
+                bn = nodes.new("ShaderNodeGroup")
+                bn.node_tree = self.function_group(fn)
+                for (name, _), a in zip(fn.inputs, node.args):
+                    feed(bn.inputs[name], a)
+                calls[node.id] = bn
+                place(bn, col, fn.name)
+                bn.width = 200
+                continue
+            elif op == "output":
+                produced[node.id] = calls[node.args[0].id].outputs[node.attr("name")]
+                continue
+            elif op in VECTOR_OPS:
+                operation, slots, out_name = VECTOR_OPS[op]
+                bn = nodes.new("ShaderNodeVectorMath")
+                bn.operation = operation
+                for i, a in zip(slots, node.args):
+                    feed(bn.inputs[i], a)
+                produced[node.id] = _socket(bn.outputs, out_name)
+            else:  # pragma: no cover - OPS and this table are kept in step
+                raise ValueError(f"no node mapping for IR operation {op!r}")
+            place(bn, col, op)
+
+        group_out = nodes.new("NodeGroupOutput")
+        place(group_out, max_depth + 1, "outputs")
+        out_items = [it for it in iface.items_tree if it.item_type == "SOCKET" and it.in_out == "OUTPUT"]
+        for (out_name, expr), item in zip(outs, out_items):
+            sock = _socket(group_out.inputs, item.identifier)
+            if expr.is_const:
+                sock.default_value = _socket_value(sock, expr.attr("value"))
+                item.default_value = _socket_value(sock, expr.attr("value"))
+            else:
+                links.new(produced[expr.id], sock)
+        return ng
+
+
 def build_node_group(name, outputs, input_order=None, lut_dir=None):
-    """Build a ShaderNodeTree group computing ``outputs`` (dict output name -> Expr of one Graph).
+    """Build a new ShaderNodeTree group computing ``outputs`` (dict output name -> Expr of one Graph).
 
     Group inputs are the graph's ``input``/``vinput`` nodes in ``input_order`` (default: sorted
     names); group outputs are the dict's keys, in dict order.  ``lut`` operations become one
-    Image Texture (Linear, EXTEND) per table and coordinate pair, with one Separate Color.
+    Image Texture (Linear, EXTEND) per table and coordinate pair, with one Separate Color;
+    function calls become Group nodes of their (shared, stamped) groups.
     """
     if not outputs:
         raise ValueError("a node group needs at least one output")
-    outs = list(outputs.items())
-    graph = outs[0][1].graph
-    if any(not isinstance(e, Expr) or e.graph is not graph for _, e in outs):
+    first = next(iter(outputs.values()))
+    if not isinstance(first, Expr):
         raise ValueError("all outputs must be expressions of one graph")
-    order = topological_order([e for _, e in outs])
-    depth = _depths(order)
-
-    inputs = {n.attr("name"): n for n in order if n.op in ("input", "vinput")}
-    names = list(input_order) if input_order is not None else sorted(inputs)
-    missing = set(inputs) - set(names)
-    if missing:
-        raise ValueError(f"input_order lacks graph inputs {sorted(missing)}")
-
+    order = topological_order(list(outputs.values()))
+    names = list(input_order) if input_order is not None else sorted(
+        n.attr("name") for n in order if n.op in ("input", "vinput"))
     ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
-    iface = ng.interface
-    for out_name, expr in outs:
-        iface.new_socket(out_name, in_out="OUTPUT",
-                         socket_type="NodeSocketVector" if expr.kind == VECTOR else "NodeSocketFloat")
-    in_items = {}
-    for n in names:
-        kind = inputs[n].kind if n in inputs else FLOAT
-        in_items[n] = iface.new_socket(n, in_out="INPUT",
-                                       socket_type="NodeSocketVector" if kind == VECTOR else "NodeSocketFloat")
-
-    nodes, links = ng.nodes, ng.links
-    max_depth = max(depth.values()) if depth else 0
-    column_rows = Counter()
-
-    def place(node, col, label):
-        row = column_rows[col]
-        column_rows[col] += 1
-        node.location = (col * COLUMN_WIDTH, -row * ROW_HEIGHT)
-        node.label = label
-
-    group_in = nodes.new("NodeGroupInput")
-    place(group_in, 0, "inputs")
-    group_in.width = 140
-
-    # socket producing each IR node: id -> output socket
-    produced = {}
-    for n, item in in_items.items():
-        if n in inputs:
-            produced[inputs[n].id] = _socket(group_in.outputs, item.identifier)
-    separators = {}       # source vector id -> ShaderNodeSeparateXYZ
-    textures = {}         # (table, u id, v id) -> (Image Texture node, Separate Color node)
-
-    def feed(socket, arg):
-        if arg.is_const:
-            value = arg.attr("value")
-            socket.default_value = value
-        else:
-            links.new(produced[arg.id], socket)
-
-    for node in order:
-        op = node.op
-        if op in _LEAVES:
-            continue
-        col = depth[node.id]
-        if op in MATH_OPS:
-            bn = nodes.new("ShaderNodeMath")
-            bn.operation = MATH_OPS[op]
-            bn.use_clamp = False
-            for i, a in enumerate(node.args):
-                feed(bn.inputs[i], a)
-            if op == "log2":
-                bn.inputs[1].default_value = 2.0
-            produced[node.id] = bn.outputs[0]
-        elif op in MIX_SOCKETS:
-            fac, a_id, b_id, res = MIX_SOCKETS[op]
-            bn = nodes.new("ShaderNodeMix")
-            bn.data_type = "FLOAT" if op == "select" else "VECTOR"
-            if op == "vselect":
-                bn.factor_mode = "UNIFORM"
-            cond, if_true, if_false = node.args
-            feed(_socket(bn.inputs, fac), cond)
-            feed(_socket(bn.inputs, a_id), if_false)
-            feed(_socket(bn.inputs, b_id), if_true)
-            produced[node.id] = _socket(bn.outputs, res)
-        elif op == "combine":
-            bn = nodes.new("ShaderNodeCombineXYZ")
-            for i, a in enumerate(node.args):
-                feed(bn.inputs[i], a)
-            produced[node.id] = bn.outputs[0]
-        elif op in _COMPONENTS:
-            src = node.args[0]
-            bn = separators.get(src.id)
-            if bn is None:
-                bn = nodes.new("ShaderNodeSeparateXYZ")
-                feed(bn.inputs[0], src)
-                separators[src.id] = bn
-                place(bn, col, "separate")
-            produced[node.id] = bn.outputs[_COMPONENTS[op]]
-            continue
-        elif op == "lut":
-            table, channel = node.attr("table"), node.attr("channel")
-            u, v = node.args
-            key = (table, u.id, v.id)
-            if key not in textures:
-                uv = nodes.new("ShaderNodeCombineXYZ")
-                feed(uv.inputs[0], u)
-                feed(uv.inputs[1], v)
-                place(uv, col, "lut uv")
-                tex = nodes.new("ShaderNodeTexImage")
-                tex.image = lut_image(table, lut_dir)
-                tex.interpolation = "Linear"
-                tex.extension = "EXTEND"
-                links.new(uv.outputs[0], tex.inputs["Vector"])
-                place(tex, col, table)
-                sep = nodes.new("ShaderNodeSeparateColor")
-                links.new(tex.outputs["Color"], sep.inputs[0])
-                place(sep, col, "channels")
-                textures[key] = (tex, sep)
-            tex, sep = textures[key]
-            produced[node.id] = tex.outputs["Alpha"] if channel == 3 else sep.outputs[channel]
-            continue
-        elif op in VECTOR_OPS:
-            operation, slots, out_name = VECTOR_OPS[op]
-            bn = nodes.new("ShaderNodeVectorMath")
-            bn.operation = operation
-            for i, a in zip(slots, node.args):
-                feed(bn.inputs[i], a)
-            produced[node.id] = _socket(bn.outputs, out_name)
-        else:  # pragma: no cover - OPS and this table are kept in step
-            raise ValueError(f"no node mapping for IR operation {op!r}")
-        place(bn, col, op)
-
-    group_out = nodes.new("NodeGroupOutput")
-    place(group_out, max_depth + 1, "outputs")
-    out_items = [it for it in iface.items_tree if it.item_type == "SOCKET" and it.in_out == "OUTPUT"]
-    for (out_name, expr), item in zip(outs, out_items):
-        sock = _socket(group_out.inputs, item.identifier)
-        if expr.is_const:
-            sock.default_value = expr.attr("value")
-            item.default_value = expr.attr("value")
-        else:
-            links.new(produced[expr.id], sock)
+    _Emitter(lut_dir).fill(ng, outputs, names)
     return ng
+
+
+def ensure_function_group(function, lut_dir=None):
+    """The node group of a NodeFunction / expr.Function, built only when missing or when its
+    stamp (emitter version + structure hash) differs; rebuilt in place, so materials keep it."""
+    fn = getattr(function, "function", function)
+    return _Emitter(lut_dir).function_group(fn)
+
+
+def ensure_tree(name, outputs, input_names, sockets=None, internal_inputs=None, stamp_extra="",
+                lut_dir=None, description=""):
+    """A named group computing ``outputs`` with some inputs produced inside the tree
+    (``internal_inputs``); rebuilt only when the graph's structure or ``stamp_extra`` changes."""
+    from ..core.ir.expr import Function
+
+    fn = Function(name, {n: FLOAT for n in []}, outputs)
+    stamp = f"{EMITTER_VERSION}:{fn.key}:{sorted(input_names)}:{stamp_extra}"
+    ng = bpy.data.node_groups.get(name)
+    if ng is not None and ng.get("rtl_stamp") == stamp:
+        return ng, False
+    if ng is None:
+        ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    else:
+        ng.nodes.clear()
+        ng.interface.clear()
+    _Emitter(lut_dir).fill(ng, outputs, input_names, sockets, internal_inputs=internal_inputs,
+                           description=description)
+    ng["rtl_stamp"] = stamp
+    return ng, True
+
+
+def tree_node_counts(ng, seen=None):
+    """{group name: node count} for ``ng`` and every group nested in it (each once)."""
+    seen = {} if seen is None else seen
+    if ng.name in seen:
+        return seen
+    seen[ng.name] = len(ng.nodes)
+    for node in ng.nodes:
+        if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
+            tree_node_counts(node.node_tree, seen)
+    return seen
+
+
+def flat_tree_node_count(ng):
+    """Nodes of ``ng`` with every Group node replaced by its content (recursively)."""
+    total = 0
+    for node in ng.nodes:
+        if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
+            total += flat_tree_node_count(node.node_tree) - 2   # minus the inner group input/output
+        else:
+            total += 1
+    return total
 
 
 def node_group_stats(ng):

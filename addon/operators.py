@@ -77,4 +77,34 @@ class RTL_OT_lut_status(bpy.types.Operator):
         return {'FINISHED'}
 
 
-classes = (RTL_OT_lut_status,)
+class RTL_OT_sync_lights(bpy.types.Operator):
+    """Rebuild the RT Lit groups for the lights now in the scene (after adding, removing or
+    changing the shape of a light; moving or editing a light needs no sync: drivers follow it)"""
+
+    bl_idname = "rtl.sync_lights"
+    bl_label = "Sync RT Lit Lights"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        if context.scene is None:
+            cls.poll_message_set("No active scene")
+            return False
+        return True
+
+    def execute(self, context):
+        from . import materials
+
+        lut_dir = preferences.lut_directory(context)
+        try:
+            records = materials.sync_scene_lights(context.scene)
+            groups = materials.rebuild_rt_lit_groups(context.scene, lut_dir)
+        except Exception as ex:
+            self.report({'ERROR'}, f"Could not sync lights: {ex}")
+            return {'CANCELLED'}
+        kinds = ", ".join(f"{obj.name} ({kind})" for obj, kind in records) or "none"
+        self.report({'INFO'}, f"RT Lit: {len(records)} lights [{kinds}]; {len(groups)} RT Lit groups rebuilt")
+        return {'FINISHED'}
+
+
+classes = (RTL_OT_lut_status, RTL_OT_sync_lights)

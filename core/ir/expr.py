@@ -153,6 +153,7 @@ class Expr:
         raise TypeError("a traced expression has no truth value; use shading_ops.select")
 
     __hash__ = object.__hash__
+    __array_ufunc__ = None      # numpy_array + expr defers to Expr.__radd__ instead of broadcasting
 
     def _bin(self, other, op, vop=None, reverse=False):
         g = self.graph

@@ -142,7 +142,8 @@ def test_every_ir_operation_renders_like_numpy(empty_scene):
 
     g = Graph()
     a, b, u, v = g.input("a"), g.input("b"), g.input("u", "vector"), g.input("v", "vector")
-    binary = ("add", "subtract", "multiply", "divide", "power", "minimum", "maximum", "less_than", "greater_than")
+    binary = ("add", "subtract", "multiply", "divide", "power", "minimum", "maximum", "less_than", "greater_than",
+              "arctan2")
     unary = ("sqrt", "inverse_sqrt", "exponent", "log2", "absolute", "arccosine", "arcsine", "sine", "cosine",
              "tangent")
     outputs = {op: g.make(op, (a, b)) for op in binary}
@@ -153,7 +154,7 @@ def test_every_ir_operation_renders_like_numpy(empty_scene):
     outputs["combine"] = g.make("combine", (a, b, g.make("multiply", (a, b))))
     for c in "xyz":
         outputs[c] = g.make(c, (u,))
-    outputs.update({op: g.make(op, (u, v)) for op in ("vadd", "vsubtract", "dot", "cross")})
+    outputs.update({op: g.make(op, (u, v)) for op in ("vadd", "vsubtract", "vmultiply", "dot", "cross")})
     outputs["vscale"] = g.make("vscale", (u, a))
     outputs["length"] = g.make("length", (u,))
     outputs["normalize"] = g.make("normalize", (u,))

@@ -1,0 +1,690 @@
+"""Convert a Principled BSDF material into an RT Lit lookdev material and back.
+
+An RT Lit material's surface is ``RT Lit group node -> Emission (strength 1) -> Material
+Output``: the group computes the outgoing radiance itself.  The group's inputs
+(``RT_LIT_INPUTS``) take the Principled BSDF's names where one exists, so the conversion maps
+them one to one (``MAPPED_INPUTS``): a linked input is re-linked from the same source socket, an
+unlinked one gets the value copied (the value is copied under a link too, so it is there when
+the link goes).
+
+The round trip is lossless: the original Principled BSDF node is kept in the tree, unlinked
+from the output, collapsed in a frame labelled ``FRAME_LABEL``; its inputs without an RT Lit
+counterpart (Subsurface, Coat, Alpha, ...) and its settings (distribution, subsurface method)
+stay on it untouched.  Converting back writes the RT Lit node's current values and links into
+it (so edits made in RT Lit survive), reconnects it to the output and removes the RT Lit nodes;
+the RT Lit group datablock is left alone.  The RT Lit-only inputs (Wrap, Cloth ...) have no
+Principled counterpart: their unlinked values are remembered on the material and restored on the
+next conversion.
+
+The material remembers its switches in ``material["rtl_features"]`` (a dict of ``Features``);
+a conversion without explicit features reuses them.  Converting an RT Lit material again is
+idempotent: no nodes are added, the group is swapped only when the features ask for another one.
+
+The pure functions raise ``ConversionError`` (before changing anything) when a material cannot
+be converted; the operators turn that into reports.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty
+
+from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, RT_LIT_INPUTS, SPECULAR_MODELS,
+                                               Features)
+
+#: Principled BSDF input -> RT Lit input (same names).  "Normal" is link-only.
+MAPPED_INPUTS = (
+    "Base Color", "Metallic", "Roughness", "IOR", "Specular IOR Level", "Specular Tint",
+    "Sheen Weight", "Sheen Tint", "Emission Color", "Emission Strength", "Normal",
+)
+#: Inputs whose value is never copied (only their link): the value is hidden and unused.
+LINK_ONLY_INPUTS = ("Normal",)
+#: RT Lit inputs with no Principled counterpart; their values are remembered on the material.
+RT_LIT_ONLY_INPUTS = tuple(name for name in RT_LIT_INPUTS if name not in MAPPED_INPUTS)
+
+RT_LIT_NODE_NAME = "RT Lit"
+EMISSION_NODE_NAME = "RT Lit Emission"
+FRAME_NODE_NAME = "RT Lit Kept Principled"
+FRAME_LABEL = "Original Principled (kept for conversion back)"
+RT_LIT_OUTPUT = "Radiance"
+
+#: Custom properties.  On the material:
+FEATURES_PROP = "rtl_features"          # dict of Features: the material's switches
+RT_ONLY_VALUES_PROP = "rtl_rt_only"     # dict: RT Lit-only input values, kept while Principled
+#: On nodes this module creates or keeps:
+ROLE_PROP = "rtl_role"                  # "rt_lit" | "emission" | "frame" | "kept_principled"
+SAVED_LOCATION_PROP = "rtl_location"    # kept Principled: where it stood (absolute)
+SAVED_PARENT_PROP = "rtl_parent"        # kept Principled: its frame before ("" = none)
+SAVED_HIDE_PROP = "rtl_hide"            # kept Principled: was it collapsed
+
+FLOAT_TOLERANCE = 1e-6
+
+SPECULAR_LABELS = {
+    "single": ("Single Scattering", "GGX single scattering only (loses energy at high roughness)"),
+    "turquin": ("Turquin", "Turquin 2019 energy compensation (scales the GGX lobe by 1 / E)"),
+    "fdez_aguera": ("Fdez-Agüera", "Fdez-Agüera 2019 multiple-scattering approximation"),
+    "kulla_conty": ("Kulla-Conty", "Kulla & Conty 2017 multiple-scattering lobe"),
+}
+DIFFUSE_LABELS = {
+    "lambert": ("Lambert", "Lambertian diffuse"),
+    "cod": ("CoD WWII", "Call of Duty WWII multiscattering diffuse (Chan 2018)"),
+    "wrapped": ("Wrapped", "Energy-conserving wrapped diffuse (uses the Wrap input)"),
+}
+
+SPECULAR_ITEMS = tuple((m, *SPECULAR_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SPECULAR_MODELS)
+DIFFUSE_ITEMS = tuple((m, *DIFFUSE_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in DIFFUSE_MODELS)
+
+
+class ConversionError(ValueError):
+    """A material cannot be converted; raised before anything is changed."""
+
+
+@dataclass
+class ConversionResult:
+    """What a conversion did.  ``status``: "converted", "updated" (an RT Lit material got new
+    switches) or "unchanged" (an RT Lit material converted again with the same switches)."""
+    material: str
+    status: str
+    warnings: list[str] = field(default_factory=list)
+    #: Principled inputs RT Lit ignores that were non-default or linked (kept on the stored node).
+    ignored_inputs: tuple[str, ...] = ()
+    features: Features | None = None
+
+
+# --------------------------------------------------------------------------------------------
+# Tree helpers
+
+
+def _role(node):
+    try:
+        return node.get(ROLE_PROP)
+    except TypeError:  # nodes without ID properties
+        return None
+
+
+def _nodes_with_role(tree, role):
+    return [n for n in tree.nodes if _role(n) == role]
+
+
+def _active_output(tree):
+    """The active Material Output (the one for all render engines first), or None."""
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    if not outputs:
+        return None
+    try:
+        node = tree.get_output_node('ALL')
+    except (AttributeError, TypeError):
+        node = None
+    if node is not None:
+        return node
+    active = [n for n in outputs if n.is_active_output]
+    for target in ('ALL', 'EEVEE', 'CYCLES'):
+        for n in active:
+            if n.target == target:
+                return n
+    return active[0] if active else outputs[0]
+
+
+def _source_node(socket):
+    """The node feeding ``socket`` (following reroutes), or None."""
+    seen = set()
+    while socket.is_linked:
+        link = socket.links[0]
+        node = link.from_node
+        if node.bl_idname != "NodeReroute" or node.name in seen:
+            return node
+        seen.add(node.name)
+        socket = node.inputs[0]
+    return None
+
+
+def _is_rt_lit_node(node):
+    return node is not None and node.bl_idname == "ShaderNodeGroup" and (
+        _role(node) == "rt_lit" or node.name == RT_LIT_NODE_NAME)
+
+
+def _rt_lit_feeding(output):
+    """The RT Lit node feeding the output's Surface (directly or through an Emission), or None."""
+    node = _source_node(output.inputs["Surface"])
+    if node is not None and node.bl_idname == "ShaderNodeEmission":
+        node = _source_node(node.inputs["Color"])
+    return node if _is_rt_lit_node(node) else None
+
+
+def find_rt_lit_node(material):
+    """The material's RT Lit group node: the one feeding the active output, else any (tagged or
+    named ``RT_LIT_NODE_NAME``), else None."""
+    tree = material.node_tree
+    if tree is None:
+        return None
+    output = _active_output(tree)
+    node = _rt_lit_feeding(output) if output is not None else None
+    if node is not None:
+        return node
+    tagged = [n for n in tree.nodes if n.bl_idname == "ShaderNodeGroup" and _role(n) == "rt_lit"]
+    if tagged:
+        return tagged[0]
+    node = tree.nodes.get(RT_LIT_NODE_NAME)
+    return node if _is_rt_lit_node(node) else None
+
+
+def is_rt_lit_material(material):
+    return material is not None and find_rt_lit_node(material) is not None
+
+
+def _value(socket):
+    value = socket.default_value
+    try:
+        return tuple(value)
+    except TypeError:
+        return value
+
+
+def _copy_value(src, dst):
+    """Copy ``src``'s default value to ``dst`` (float, colour or vector; sizes adapted)."""
+    if not hasattr(src, "default_value") or not hasattr(dst, "default_value"):
+        return
+    value = _value(src)
+    target = _value(dst)
+    if isinstance(target, tuple):
+        if not isinstance(value, tuple):
+            value = (value,) * len(target)
+        value = tuple(value[:len(target)]) + tuple(target[len(value):])
+    elif isinstance(value, tuple):
+        value = sum(value[:3]) / min(len(value), 3)
+    dst.default_value = value
+
+
+def _relink(tree, src_input, dst_input):
+    """Make ``dst_input``'s links those of ``src_input`` (same source sockets), or none."""
+    for link in list(dst_input.links):
+        tree.links.remove(link)
+    for link in src_input.links:
+        new = tree.links.new(link.from_socket, dst_input)
+        new.is_muted = link.is_muted
+
+
+def _transfer(tree, src_node, dst_node, names):
+    """Copy values and links of the inputs ``names`` from ``src_node`` to ``dst_node``."""
+    for name in names:
+        src, dst = src_node.inputs.get(name), dst_node.inputs.get(name)
+        if src is None or dst is None:
+            continue
+        if name not in LINK_ONLY_INPUTS:
+            _copy_value(src, dst)
+        _relink(tree, src, dst)
+
+
+def _equal(a, b):
+    if isinstance(a, tuple) or isinstance(b, tuple):
+        a, b = tuple(a) if isinstance(a, tuple) else (a,), tuple(b) if isinstance(b, tuple) else (b,)
+        return len(a) == len(b) and all(abs(x - y) <= FLOAT_TOLERANCE for x, y in zip(a, b))
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return abs(a - b) <= FLOAT_TOLERANCE
+    return a == b
+
+
+_principled_defaults: dict[str, object] = {}
+
+
+def principled_defaults():
+    """Default input values of a fresh Principled BSDF (identifier -> value), read once."""
+    if not _principled_defaults:
+        group = bpy.data.node_groups.new(".rtl_principled_defaults", "ShaderNodeTree")
+        try:
+            node = group.nodes.new("ShaderNodeBsdfPrincipled")
+            for socket in node.inputs:
+                if hasattr(socket, "default_value"):
+                    _principled_defaults[socket.identifier] = _value(socket)
+        finally:
+            bpy.data.node_groups.remove(group)
+    return _principled_defaults
+
+
+def ignored_principled_inputs(node):
+    """Principled inputs RT Lit has no counterpart for that are linked or non-default, in node
+    order (names; disabled sockets, such as Subsurface IOR under Random Walk, are skipped)."""
+    defaults = principled_defaults()
+    ignored = []
+    for socket in node.inputs:
+        if socket.name in MAPPED_INPUTS or not socket.enabled:
+            continue
+        if socket.is_linked:
+            ignored.append(socket.name)
+        elif hasattr(socket, "default_value") and socket.identifier in defaults \
+                and not socket.hide_value and not _equal(_value(socket), defaults[socket.identifier]):
+            ignored.append(socket.name)
+    return tuple(ignored)
+
+
+def stored_features(material):
+    """The features remembered on the material, or None."""
+    data = material.get(FEATURES_PROP) if material is not None else None
+    if data is None:
+        return None
+    try:
+        data = data.to_dict() if hasattr(data, "to_dict") else dict(data)
+        features = Features.from_dict(data)
+        return Features(specular=str(features.specular), diffuse=str(features.diffuse),
+                        sheen=bool(features.sheen), cloth=bool(features.cloth))
+    except (TypeError, ValueError):
+        return None
+
+
+def _store_features(material, features):
+    material[FEATURES_PROP] = features.as_dict()
+
+
+def _absolute_location(node):
+    loc = getattr(node, "location_absolute", None)
+    return tuple(loc if loc is not None else node.location)
+
+
+def _check_editable(material):
+    if material is None:
+        raise ConversionError("No material to convert")
+    if material.library is not None:
+        raise ConversionError(f"Material '{material.name}' is linked from a library and cannot be edited")
+    if material.node_tree is None:
+        raise ConversionError(f"Material '{material.name}' has no node tree (it does not use nodes)")
+    output = _active_output(material.node_tree)
+    if output is None:
+        raise ConversionError(f"Material '{material.name}' has no Material Output node")
+    return material.node_tree, output
+
+
+# --------------------------------------------------------------------------------------------
+# Principled -> RT Lit
+
+
+def _swap_group(tree, rt, group):
+    """Point ``rt`` at ``group``, keeping its input values and links (by name)."""
+    if rt.node_tree == group:
+        return False
+    values = {s.name: _value(s) for s in rt.inputs if hasattr(s, "default_value")}
+    links = {s.name: [(l.from_socket, l.is_muted) for l in s.links] for s in rt.inputs}
+    rt.node_tree = group
+    for socket in rt.inputs:
+        if socket.name in values and hasattr(socket, "default_value"):
+            try:
+                socket.default_value = values[socket.name]
+            except (TypeError, ValueError):
+                pass
+        for from_socket, muted in links.get(socket.name, ()):
+            if not socket.is_linked:
+                tree.links.new(from_socket, socket).is_muted = muted
+    return True
+
+
+def _restore_kept_principled(node):
+    """Take a kept Principled out of the frame, back where it stood; drop the bookkeeping."""
+    location = node.get(SAVED_LOCATION_PROP)
+    parent_name = node.get(SAVED_PARENT_PROP, "")
+    hide = node.get(SAVED_HIDE_PROP)
+    tree = node.id_data
+    node.parent = None
+    if location is not None:
+        node.location = tuple(location)
+    parent = tree.nodes.get(parent_name) if parent_name else None
+    if parent is not None and parent.bl_idname == "NodeFrame":
+        node.parent = parent
+    if hide is not None:
+        node.hide = bool(hide)
+    for key in (ROLE_PROP, SAVED_LOCATION_PROP, SAVED_PARENT_PROP, SAVED_HIDE_PROP):
+        if key in node:
+            del node[key]
+
+
+def _remove_rt_lit_nodes(tree, rt=None):
+    """Remove the RT Lit node(s), the Emission and the kept-frame this module made."""
+    doomed = _nodes_with_role(tree, "rt_lit") + _nodes_with_role(tree, "emission")
+    if rt is not None and rt not in doomed:
+        doomed.append(rt)
+    for frame in _nodes_with_role(tree, "frame"):
+        for child in [n for n in tree.nodes if n.parent == frame]:
+            child.parent = None
+        doomed.append(frame)
+    for node in doomed:
+        tree.nodes.remove(node)
+
+
+def principled_to_rt_lit(material, group_factory, features=None):
+    """Convert ``material`` from a Principled BSDF to an RT Lit material (see the module doc).
+
+    ``group_factory(features) -> ShaderNodeTree`` gives the RT Lit group; ``features`` (a
+    ``Features``) defaults to the ones stored on the material, else ``Features()``.  Returns a
+    ``ConversionResult``; raises ``ConversionError`` (changing nothing) when the active Material
+    Output's Surface is not fed by a Principled BSDF (or an RT Lit material).
+    """
+    tree, output = _check_editable(material)
+    if features is None:
+        features = stored_features(material) or Features()
+    elif not isinstance(features, Features):
+        features = Features.from_dict(features)
+
+    rt = _rt_lit_feeding(output)
+    if rt is not None:  # already RT Lit: only the switches may change
+        group = group_factory(features)
+        swapped = _swap_group(tree, rt, group)
+        changed = swapped or stored_features(material) != features
+        _store_features(material, features)
+        rt.label = f"RT Lit ({features.label()})"
+        return ConversionResult(material.name, "updated" if changed else "unchanged", features=features)
+
+    principled = _source_node(output.inputs["Surface"])
+    if principled is None or principled.bl_idname != "ShaderNodeBsdfPrincipled":
+        found = "nothing" if principled is None else f"'{principled.name}' ({principled.bl_label})"
+        raise ConversionError(
+            f"Material '{material.name}': the Surface of the active Material Output '{output.name}' "
+            f"must be fed by a Principled BSDF, but is fed by {found}")
+
+    group = group_factory(features)
+    if group is None:
+        raise ConversionError("The RT Lit group factory returned no node group")
+    sockets = [i for i in group.interface.items_tree if getattr(i, "item_type", "SOCKET") == 'SOCKET']
+    missing = [name for name in MAPPED_INPUTS
+               if name not in {i.name for i in sockets if i.in_out == 'INPUT'}]
+    if missing or RT_LIT_OUTPUT not in {i.name for i in sockets if i.in_out == 'OUTPUT'}:
+        raise ConversionError(f"Node group '{group.name}' is not an RT Lit group "
+                              f"(missing inputs {missing} or output '{RT_LIT_OUTPUT}')")
+
+    # Leftovers of an earlier conversion whose Principled was plugged back by hand.
+    for node in _nodes_with_role(tree, "kept_principled"):
+        _restore_kept_principled(node)
+    _remove_rt_lit_nodes(tree)
+
+    ignored = ignored_principled_inputs(principled)
+    px, py = _absolute_location(principled)
+
+    rt = tree.nodes.new("ShaderNodeGroup")
+    rt.node_tree = group
+    rt.name = RT_LIT_NODE_NAME
+    rt.label = f"RT Lit ({features.label()})"
+    rt[ROLE_PROP] = "rt_lit"
+    rt.width = max(rt.width, 240.0)
+    rt.location = (px - 180.0, py)
+
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.name = EMISSION_NODE_NAME
+    emission.label = "RT Lit Radiance"
+    emission[ROLE_PROP] = "emission"
+    emission.inputs["Strength"].default_value = 1.0
+    emission.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    emission.location = (px - 180.0 + rt.width + 40.0, py)
+
+    _transfer(tree, principled, rt, MAPPED_INPUTS)
+    remembered = material.get(RT_ONLY_VALUES_PROP)
+    if remembered is not None:
+        for name in RT_LIT_ONLY_INPUTS:
+            socket = rt.inputs.get(name)
+            if socket is not None and name in remembered and hasattr(socket, "default_value"):
+                value = remembered[name]
+                try:
+                    socket.default_value = tuple(value) if hasattr(value, "__len__") else value
+                except (TypeError, ValueError):
+                    pass
+        del material[RT_ONLY_VALUES_PROP]
+
+    tree.links.new(rt.outputs[RT_LIT_OUTPUT], emission.inputs["Color"])
+    tree.links.new(emission.outputs["Emission"], output.inputs["Surface"])  # replaces the BSDF link
+
+    # Keep the Principled node, collapsed in a labelled frame below the RT Lit node.
+    frame = tree.nodes.new("NodeFrame")
+    frame.name = FRAME_NODE_NAME
+    frame.label = FRAME_LABEL
+    frame[ROLE_PROP] = "frame"
+    frame.location = (px - 180.0, py - 700.0)
+    old_parent = principled.parent
+    principled[SAVED_LOCATION_PROP] = (px, py)
+    principled[SAVED_PARENT_PROP] = old_parent.name if old_parent is not None else ""
+    principled[SAVED_HIDE_PROP] = bool(principled.hide)
+    principled[ROLE_PROP] = "kept_principled"
+    principled.parent = None
+    principled.location = (px - 160.0, py - 740.0)
+    principled.hide = True
+    principled.parent = frame
+
+    _store_features(material, features)
+    result = ConversionResult(material.name, "converted", ignored_inputs=ignored, features=features)
+    if ignored:
+        result.warnings.append(
+            f"Material '{material.name}': RT Lit ignores the Principled inputs "
+            f"{', '.join(ignored)}; they stay on the kept Principled BSDF and come back on "
+            "conversion to Principled")
+    return result
+
+
+# --------------------------------------------------------------------------------------------
+# RT Lit -> Principled
+
+
+def _kept_principled(tree):
+    kept = [n for n in _nodes_with_role(tree, "kept_principled") if n.bl_idname == "ShaderNodeBsdfPrincipled"]
+    if kept:
+        return kept[0]
+    frame = tree.nodes.get(FRAME_NODE_NAME)
+    if frame is not None:
+        for node in tree.nodes:
+            if node.parent == frame and node.bl_idname == "ShaderNodeBsdfPrincipled":
+                return node
+    return None
+
+
+def rt_lit_to_principled(material):
+    """Convert an RT Lit material back to a Principled BSDF (see the module doc).
+
+    Restores the kept Principled BSDF (or creates one), writes the RT Lit node's current values
+    and links of ``MAPPED_INPUTS`` into it, connects it to the active Material Output's Surface
+    and removes the RT Lit node, its Emission and the kept-frame; the RT Lit group datablock
+    stays.  Returns a ``ConversionResult``; raises ``ConversionError`` (changing nothing) when
+    the material has no RT Lit node.
+    """
+    tree, output = _check_editable(material)
+    rt = find_rt_lit_node(material)
+    if rt is None:
+        raise ConversionError(f"Material '{material.name}' is not an RT Lit material (no '{RT_LIT_NODE_NAME}' "
+                              "group node)")
+    if rt.node_tree is None:
+        raise ConversionError(f"Material '{material.name}': the RT Lit node '{rt.name}' has no node group")
+
+    result = ConversionResult(material.name, "converted", features=stored_features(material))
+    principled = _kept_principled(tree)
+    if principled is None:
+        principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
+        principled.location = _absolute_location(rt)
+        result.warnings.append(f"Material '{material.name}': the original Principled BSDF was not found; "
+                               "created a new one from the RT Lit values")
+    else:
+        _restore_kept_principled(principled)
+
+    _transfer(tree, rt, principled, MAPPED_INPUTS)
+
+    remembered, dropped = {}, []
+    for name in RT_LIT_ONLY_INPUTS:
+        socket = rt.inputs.get(name)
+        if socket is None:
+            continue
+        if hasattr(socket, "default_value"):
+            remembered[name] = _value(socket)
+        if socket.is_linked:
+            dropped.append(name)
+    if remembered:
+        material[RT_ONLY_VALUES_PROP] = remembered
+    if dropped:
+        result.warnings.append(f"Material '{material.name}': Principled has no counterpart for the linked "
+                               f"RT Lit inputs {', '.join(dropped)}; their links are dropped")
+
+    _remove_rt_lit_nodes(tree, rt)
+    tree.links.new(principled.outputs["BSDF"], output.inputs["Surface"])
+    return result
+
+
+# --------------------------------------------------------------------------------------------
+# Operators
+
+TARGET_ITEMS = (
+    ('ACTIVE', "Active Material", "Convert the active material"),
+    ('SELECTED', "Selected Objects", "Convert every material of the selected objects"),
+)
+
+
+def default_group_factory():
+    """The add-on's RT Lit group factory (imported lazily: ``.materials`` is optional here)."""
+    from .materials import ensure_rt_lit_group
+    return ensure_rt_lit_group
+
+
+def _active_material(context):
+    material = getattr(context, "material", None)
+    if material is None:
+        obj = getattr(context, "object", None) or getattr(context, "active_object", None)
+        material = obj.active_material if obj is not None else None
+    return material
+
+
+def _selected_materials(context):
+    materials, seen = [], set()
+    for obj in getattr(context, "selected_objects", None) or ():
+        for slot in obj.material_slots:
+            mat = slot.material
+            if mat is not None and mat.name_full not in seen:
+                seen.add(mat.name_full)
+                materials.append(mat)
+    return materials
+
+
+def target_materials(context, target):
+    if target == 'SELECTED':
+        return _selected_materials(context)
+    material = _active_material(context)
+    return [material] if material is not None else []
+
+
+def _report_results(op, done, failures, verb):
+    """One report per kind; returns the operator's result set."""
+    warnings = [w for r in done for w in r.warnings]
+    for message in failures + warnings:
+        print(f"RT Lookdev: {message}")
+    if not done:
+        op.report({'ERROR'}, "; ".join(failures) if failures else "No material to convert")
+        return {'CANCELLED'}
+    names = ", ".join(f"'{r.material}'" for r in done)
+    summary = f"{verb} {len(done)} material{'s' if len(done) != 1 else ''} ({names})"
+    if failures or warnings:
+        op.report({'WARNING'}, "; ".join([summary] + failures + warnings))
+    else:
+        op.report({'INFO'}, summary)
+    return {'FINISHED'}
+
+
+class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
+    """Convert Principled BSDF materials to RT Lit lookdev materials (the Principled BSDF is kept,
+    collapsed, for converting back)"""
+
+    bl_idname = "rtl.convert_to_rt_lit"
+    bl_label = "Convert to RT Lit"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    target: EnumProperty(name="Materials", items=TARGET_ITEMS, default='ACTIVE')
+    specular: EnumProperty(
+        name="Specular",
+        description="Specular multiple-scattering model the RT Lit group is built with",
+        items=SPECULAR_ITEMS,
+        default=Features().specular,
+    )
+    diffuse: EnumProperty(
+        name="Diffuse",
+        description="Diffuse model the RT Lit group is built with",
+        items=DIFFUSE_ITEMS,
+        default=Features().diffuse,
+    )
+    sheen: BoolProperty(name="Sheen", description="Build the group with the Disney sheen lobe",
+                        default=Features().sheen)
+    cloth: BoolProperty(name="Cloth", description="Build the group with the Ashikhmin cloth lobe",
+                        default=Features().cloth)
+
+    @classmethod
+    def poll(cls, context):
+        if _active_material(context) is None and not _selected_materials(context):
+            cls.poll_message_set("No active material, and no selected object has a material")
+            return False
+        return True
+
+    def features(self):
+        return Features(specular=self.specular, diffuse=self.diffuse, sheen=self.sheen, cloth=self.cloth)
+
+    def invoke(self, context, event):
+        stored = stored_features(_active_material(context))
+        if stored is not None:
+            self.specular, self.diffuse = stored.specular, stored.diffuse
+            self.sheen, self.cloth = stored.sheen, stored.cloth
+        return context.window_manager.invoke_props_dialog(self)
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "target")
+        layout.prop(self, "specular")
+        layout.prop(self, "diffuse")
+        row = layout.row()
+        row.prop(self, "sheen")
+        row.prop(self, "cloth")
+
+    def execute(self, context):
+        materials = target_materials(context, self.target)
+        if not materials:
+            self.report({'ERROR'}, "No material to convert" + (
+                " (no selected object has a material)" if self.target == 'SELECTED' else ""))
+            return {'CANCELLED'}
+        try:
+            factory = default_group_factory()
+        except ImportError as ex:
+            self.report({'ERROR'}, f"The RT Lit node group is not available: {ex}")
+            return {'CANCELLED'}
+        features = self.features()
+        done, failures = [], []
+        for material in materials:
+            try:
+                done.append(principled_to_rt_lit(material, factory, features))
+            except ConversionError as ex:
+                failures.append(str(ex))
+            except Exception as ex:  # the group factory failed: nothing was changed
+                failures.append(f"Material '{material.name}': could not build the RT Lit group "
+                                f"({type(ex).__name__}: {ex})")
+        return _report_results(self, done, failures, f"Converted to RT Lit ({features.label()})")
+
+
+class RTL_OT_convert_to_principled(bpy.types.Operator):
+    """Convert RT Lit materials back to Principled BSDF, keeping the values and links edited in RT Lit"""
+
+    bl_idname = "rtl.convert_to_principled"
+    bl_label = "Convert to Principled"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    target: EnumProperty(name="Materials", items=TARGET_ITEMS, default='ACTIVE')
+
+    @classmethod
+    def poll(cls, context):
+        candidates = [_active_material(context)] + _selected_materials(context)
+        if not any(is_rt_lit_material(m) for m in candidates if m is not None):
+            cls.poll_message_set("Neither the active material nor a selected object's material is an RT Lit material")
+            return False
+        return True
+
+    def execute(self, context):
+        materials = [m for m in target_materials(context, self.target)]
+        if not materials:
+            self.report({'ERROR'}, "No material to convert")
+            return {'CANCELLED'}
+        if self.target == 'SELECTED':  # non-RT Lit materials among the selection are not errors
+            materials = [m for m in materials if is_rt_lit_material(m)] or materials
+        done, failures = [], []
+        for material in materials:
+            try:
+                done.append(rt_lit_to_principled(material))
+            except ConversionError as ex:
+                failures.append(str(ex))
+        return _report_results(self, done, failures, "Converted to Principled")
+
+
+classes = (RTL_OT_convert_to_rt_lit, RTL_OT_convert_to_principled)
