@@ -110,8 +110,13 @@ def _new_interface_socket(iface, name, in_out, kind, spec, panels):
         if parent is None:
             parent = panels[spec.panel] = iface.new_panel(spec.panel, default_closed=False)
     item = iface.new_socket(name, in_out=in_out, socket_type=_SOCKET_TYPES[socket_kind], parent=parent)
-    if spec is None:
-        return item
+    if spec is not None:
+        _apply_socket_spec(item, in_out, spec)
+    return item
+
+
+def _apply_socket_spec(item, in_out, spec):
+    socket_kind = spec.kind
     item.description = spec.description
     if spec.subtype and spec.subtype != "NONE":
         item.subtype = spec.subtype
@@ -126,6 +131,35 @@ def _new_interface_socket(iface, name, in_out, kind, spec, panels):
             item.max_value = spec.max
         item.hide_value = spec.hide_value
     return item
+
+
+def _interface_signature(spec_list):
+    return sorted((name, in_out, _SOCKET_TYPES[spec.kind if spec is not None else kind],
+                   spec.panel if spec is not None else None) for name, in_out, kind, spec in spec_list)
+
+
+def _ensure_interface(ng, wanted):
+    """Interface items (name, in_out) -> item for ``wanted`` [(name, in_out, kind, Socket)].
+
+    An interface that already has exactly these sockets (names, types, panels) is kept as it is:
+    Group nodes using the tree keep their links and values when it is rebuilt.  Otherwise the
+    interface is created anew (descriptions, ranges and defaults are refreshed either way)."""
+    iface = ng.interface
+    existing = [it for it in iface.items_tree if it.item_type == "SOCKET"]
+    current = sorted((it.name, it.in_out, it.socket_type, it.parent.name if it.parent and it.parent.name else None)
+                     for it in existing)
+    keep = current == _interface_signature(wanted) and len({(it.name, it.in_out) for it in existing}) == len(existing)
+    if not keep:
+        iface.clear()
+        panels = {}
+        items = {(name, in_out): _new_interface_socket(iface, name, in_out, kind, spec, panels)
+                 for name, in_out, kind, spec in wanted}
+    else:
+        items = {(it.name, it.in_out): it for it in existing}
+        for name, in_out, kind, spec in wanted:
+            if spec is not None:
+                _apply_socket_spec(items[(name, in_out)], in_out, spec)
+    return items
 
 
 class _Emitter:
@@ -150,7 +184,6 @@ class _Emitter:
             return ng
         else:
             ng.nodes.clear()
-            ng.interface.clear()
         self.fill(ng, fn.outputs, [n for n, _ in fn.inputs], fn.sockets,
                   {n: k for n, k in fn.inputs}, description=fn.description)
         ng["rtl_stamp"] = stamp
@@ -169,11 +202,12 @@ class _Emitter:
     def fill(self, ng, outputs, input_names, sockets=None, kinds=None, internal_inputs=None, description=""):
         """Emit ``outputs`` (name -> Expr of one graph) into the empty tree ``ng``.
 
-        ``input_names``: interface inputs, in order; ``sockets``: name -> interface.Socket for
-        inputs and outputs; ``internal_inputs``: graph input name -> callable(nodes, links) giving
+        ``input_names``: interface inputs, in order; ``sockets``: (inputs, outputs), each
+        name -> interface.Socket; ``internal_inputs``: graph input name -> callable(nodes, links) giving
         an output socket inside the tree (e.g. Geometry > Position) instead of an interface input.
         """
-        sockets, kinds, internal_inputs = sockets or {}, kinds or {}, internal_inputs or {}
+        in_sockets, out_sockets = sockets or ({}, {})
+        kinds, internal_inputs = kinds or {}, internal_inputs or {}
         outs = list(outputs.items())
         graph = next((e.graph for _, e in outs if isinstance(e, Expr)), None)
         if graph is None or any(not isinstance(e, Expr) or e.graph is not graph for _, e in outs):
@@ -186,14 +220,11 @@ class _Emitter:
             raise ValueError(f"inputs lack graph inputs {sorted(missing)}")
 
         ng.description = description
-        iface = ng.interface
-        panels = {}
-        for out_name, expr in outs:
-            _new_interface_socket(iface, out_name, "OUTPUT", expr.kind, sockets.get(out_name), panels)
-        in_items = {}
-        for n in input_names:
-            kind = inputs[n].kind if n in inputs else kinds.get(n, FLOAT)
-            in_items[n] = _new_interface_socket(iface, n, "INPUT", kind, sockets.get(n), panels)
+        wanted = [(out_name, "OUTPUT", expr.kind, out_sockets.get(out_name)) for out_name, expr in outs]
+        wanted += [(n, "INPUT", inputs[n].kind if n in inputs else kinds.get(n, FLOAT), in_sockets.get(n))
+                   for n in input_names]
+        items = _ensure_interface(ng, wanted)
+        in_items = {n: items[(n, "INPUT")] for n in input_names}
 
         nodes, links = ng.nodes, ng.links
         max_depth = max(depth.values()) if depth else 0
@@ -314,8 +345,8 @@ class _Emitter:
 
         group_out = nodes.new("NodeGroupOutput")
         place(group_out, max_depth + 1, "outputs")
-        out_items = [it for it in iface.items_tree if it.item_type == "SOCKET" and it.in_out == "OUTPUT"]
-        for (out_name, expr), item in zip(outs, out_items):
+        for out_name, expr in outs:
+            item = items[(out_name, "OUTPUT")]
             sock = _socket(group_out.inputs, item.identifier)
             if expr.is_const:
                 sock.default_value = _socket_value(sock, expr.attr("value"))
@@ -368,7 +399,6 @@ def ensure_tree(name, outputs, input_names, sockets=None, internal_inputs=None, 
         ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
     else:
         ng.nodes.clear()
-        ng.interface.clear()
     _Emitter(lut_dir).fill(ng, outputs, input_names, sockets, internal_inputs=internal_inputs,
                            description=description)
     ng["rtl_stamp"] = stamp

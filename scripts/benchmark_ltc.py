@@ -173,11 +173,11 @@ def _ltc_estimate(kind, inv_table, mag_table, sphere, r, mu, geom, use_fresnel=F
     u, w = lookup.ltc_lut_uv(np.array(mu), np.array(r))
     packed = lookup.sample_bilinear(inv_table, u, w)
     mag = lookup.sample_bilinear(mag_table, u, w)
-    minv = matrix.unpack_inverse(packed)
+    c = tuple(packed[..., i] for i in range(4))          # the shader path: packed Minv, traceable code
     if kind == "quad":
-        value = polygon.ltc_quad_integral(minv, geom, sphere_table=sphere)
+        value = polygon.ltc_polygon_integral_packed(c, list(geom), False, sphere)
     else:
-        value = disk.ltc_disk_integral(minv, *geom, sphere_table=sphere)
+        value = disk.ltc_disk_integral_packed(c, *geom, False, sphere)
     return float(value) * float(mag[1] if use_fresnel else mag[0]) * scale
 
 

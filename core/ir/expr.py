@@ -222,7 +222,8 @@ class Function:
         self.name, self.description = name, description
         self.inputs = list(inputs.items())
         self.outputs = dict(outputs)
-        self.sockets = dict(sockets or {})      # input/output name -> core.ir.interface.Socket
+        # (inputs, outputs): name -> core.ir.interface.Socket (an input and an output may share a name)
+        self.sockets = tuple(dict(d) for d in sockets) if sockets else ({}, {})
         graphs = {e.graph for e in self.outputs.values() if isinstance(e, Expr)}
         if len(graphs) != 1:
             raise ValueError(f"{name}: outputs must be expressions of one graph")

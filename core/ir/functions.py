@@ -8,7 +8,17 @@ evaluation, and nested Blender node groups (one group per function, instanced at
 """
 from __future__ import annotations
 
+import weakref
+
 from .expr import FLOAT, VECTOR, define, graph_of, is_expr
+
+_ALL = weakref.WeakSet()
+
+
+def invalidate_all():
+    """Forget every traced body (e.g. after the LUT folder changed: bodies hold table data)."""
+    for fn in list(_ALL):
+        fn.invalidate()
 
 _KIND = {"float": FLOAT, "vector": VECTOR, "color": VECTOR}
 
@@ -22,6 +32,11 @@ class NodeFunction:
         self.input_sockets = dict(inputs)
         self.output_sockets = dict(outputs)
         self._function = None
+        _ALL.add(self)
+
+    def invalidate(self):
+        """Trace the body again on next use."""
+        self._function = None
 
     @property
     def input_kinds(self):
@@ -31,7 +46,7 @@ class NodeFunction:
     def function(self):
         """The traced body (``expr.Function``), built on first use."""
         if self._function is None:
-            sockets = dict(self.input_sockets, **self.output_sockets)
+            sockets = (self.input_sockets, self.output_sockets)
             fn = self.fn
 
             def body(**kw):

@@ -4,10 +4,15 @@ Heitz et al. 2016, "Real-Time Polygonal-Light Shading with Linearly Transformed 
 a direction w has density D(w) = D_o(w_o) |det Minv| / |Minv w|^3 with w_o = Minv w / |Minv w|
 and D_o(w_o) = max(w_o.z, 0) / pi (eq. 1-4).  The density does not depend on the scale of
 Minv, which is therefore normalised by its middle element.
+
+Shader code keeps Minv as its four packed entries c = (c0, c1, c2, c3) (the table's channels) and
+applies it with ``transform_packed``; full 3x3 matrices appear only in numpy helpers.
 """
 from __future__ import annotations
 
 import numpy as np
+
+from .. import shading_ops as op
 
 
 def unpack_inverse(c):
@@ -20,6 +25,16 @@ def unpack_inverse(c):
     m[..., 2, 2] = c[..., 3]
     m[..., 1, 1] = 1.0
     return m
+
+
+# Heitz et al. 2016 (ltc_code's table layout, ltc.md §1.4): Minv = [[c0, 0, c2], [0, 1, 0], [c1, 0, c3]].
+def transform_packed(c, point):
+    """Minv applied to a point (a (..., 3) array or an Expr vector) for packed entries c = (c0, c1, c2, c3):
+    (c0 x + c2 z, y, c1 x + c3 z), written as two dot products with the rows (c0, 0, c2) and
+    (c1, 0, c3) (shared by every point of a light once traced)."""
+    c0, c1, c2, c3 = c
+    zero = c0 * 0.0   # a constant 0 once traced; keeps a numpy caller's dtype
+    return op.vec3(op.dot(point, op.vec3(c0, zero, c2)), op.component(point, 1), op.dot(point, op.vec3(c1, zero, c3)))
 
 
 def pack_inverse(minv):

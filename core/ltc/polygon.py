@@ -14,6 +14,14 @@ Two evaluation methods:
 - ``"clipped"``: exact clipping of the transformed polygon to the upper hemisphere and the exact
   edge integral; the reference that tests compare the clipless path with.
 
+Shader path.  Everything up to the clipless integral is written with ``core.shading_ops`` only,
+so it evaluates numpy arrays and traces into the expression IR (core/ir) alike: a polygon is a
+Python sequence of K vectors (each a (..., 3) array or an Expr vector), the LTC is given by its
+packed entries c = (c0, c1, c2, c3) (``matrix.transform_packed``), and ``LTC_QUAD_INTEGRAL`` is
+the node function (one node group) of the quad integral.  The exact clipped reference
+(``clip_to_horizon``, exact edges) is numpy-only; ``ltc_polygon_integral`` and
+``ltc_quad_integral`` keep the array API ((..., 3, 3) Minv, (..., K, 3) corners).
+
 Conventions (all in the local shading frame, shading point at the origin, N = +Z):
 corners are ordered so that the light's normal n = sum_i p_i x p_(i+1) (Newell; for a quad the
 direction of (p1 - p0) x (p3 - p0)) points away from the side it lights: a one-sided light
@@ -23,9 +31,17 @@ ltc_code demos.
 """
 from __future__ import annotations
 
+import functools
+import operator
+
 import numpy as np
 
 from .. import shading_ops as op
+from ..ir.expr import is_expr
+from ..ir.functions import NodeFunction
+from ..ir.interface import Socket, factor, vector
+from ..lut import lookup
+from . import matrix
 from . import sphere_table as spheres
 
 _INV_2PI = 0.5 / np.pi
@@ -37,39 +53,79 @@ FRAME_SIN2_MIN = 2e-6
 #: branch multiplies v1 x v2 (length sin(theta)) by 1/(2 sin(theta)), which stays <= 1/2.
 EDGE_SIN2_MIN = 1e-30
 
+#: A light whose plane passes within this angle (radians, as |p0 . n| / (|p0| |n|)) of the shading
+#: point is seen edge-on and gives 0.  Exactly in the plane the answer is a discontinuity (0 seen
+#: from the plane, the full hemisphere just in front of a light the point lies on), and which side
+#: float32 rounding picks differs between numpy and the Cycles/EEVEE kernels; this margin (100x
+#: float32 rounding of the dot product) makes all three agree.  A point nearer to the light's
+#: plane than 1e-5 of its distance to the light's first corner is treated as lying in it.
+EDGE_ON_SIN = 1e-5
+
+
+def _vectors(points):
+    """A polygon as a list of K vectors: sequences pass through, arrays (..., K, 3) are split."""
+    if isinstance(points, (list, tuple)):
+        return list(points)
+    arr = np.asarray(points)
+    return [arr[..., k, :] for k in range(arr.shape[-2])]
+
+
+def _sum(terms):
+    """Sum of vectors (no 0 start value: a float 0 plus an Expr vector is a type error)."""
+    return functools.reduce(operator.add, terms)
+
+
+def _ones_like(x):
+    """1: a constant once traced, an array of x's shape and dtype in numpy."""
+    return 1.0 if is_expr(x) else np.ones_like(x)
+
+
+def _sign(negative, like):
+    """-1 where ``negative`` else +1: a Select node once traced, an array of ``like``'s dtype in numpy."""
+    s = op.select(negative, -1.0, 1.0)
+    return s if is_expr(s) else s.astype(np.result_type(np.asarray(like).dtype, np.float32))
+
 
 # --- local frame -----------------------------------------------------------------------------
 
 # Duff, Burgess, Christensen, Hery, Kensler, Liani & Villemin 2017, "Building an Orthonormal
 # Basis, Revisited" (JCGT 6(1)): their branchless first basis vector, a unit tangent of n.
 def _any_tangent(n):
-    one = np.ones_like(n[..., 2])
-    s = op.select(n[..., 2] >= 0.0, one, -one)
-    a = -op.safe_div(one, s + n[..., 2])  # |s + n.z| >= 1 for unit n
-    return np.stack([1.0 + s * n[..., 0] * n[..., 0] * a, s * n[..., 0] * n[..., 1] * a, -s * n[..., 0]], axis=-1)
+    nx, ny, nz = (op.component(n, i) for i in range(3))
+    s = _sign(op.less(nz, 0.0), nz)
+    a = -op.safe_div(_ones_like(nz), s + nz)  # |s + n.z| >= 1 for unit n
+    return op.vec3(1.0 + s * nx * nx * a, s * nx * ny * a, -s * nx)
 
 
 # Heitz et al. 2016 / ltc_code ``ltc_quad.fs`` (ltc.md §1.5): T1 = normalize(V - N (V.N)), T2 = N x T1.
 def local_frame(n, v):
-    """Orthonormal (T1, T2, N) for unit normal n and view v (...,3); T1 falls back to any tangent
+    """Orthonormal (T1, T2, N) for unit normal n and view v (vectors); T1 falls back to any tangent
     when V is parallel to N (then the LTC is isotropic and the choice does not matter)."""
     n = op.normalize(n)
-    t = v - n * op.dot(v, n)[..., None]
-    t1 = op.select((op.dot(t, t) > FRAME_SIN2_MIN)[..., None], op.normalize(t), _any_tangent(n))
+    t = v - op.scale(n, op.dot(v, n))
+    t1 = op.vselect(op.greater(op.dot(t, t), FRAME_SIN2_MIN), op.normalize(t), _any_tangent(n))
     return t1, op.cross(n, t1), n
 
 
+def frame_coordinates(frame, d):
+    """Coordinates of vector d in the frame (T1, T2, N) of ``local_frame``: three dot products."""
+    t1, t2, n = frame
+    return op.vec3(op.dot(d, t1), op.dot(d, t2), op.dot(d, n))
+
+
 def to_local(points, p, n, v):
-    """World-space points (..., K, 3) seen from shading point p (..., 3) with normal n and view v:
-    coordinates in the (T1, T2, N) frame relative to p, and the view cosine N.V."""
-    t1, t2, n = local_frame(n, v)
-    d = np.asarray(points) - np.asarray(p)[..., None, :]
-    local = np.stack([op.dot(d, t1[..., None, :]), op.dot(d, t2[..., None, :]), op.dot(d, n[..., None, :])], axis=-1)
-    return local, op.dot(n, op.normalize(v))
+    """World-space points seen from shading point p with normal n and view v: coordinates in the
+    (T1, T2, N) frame relative to p, and the view cosine N.V.  ``points`` is a sequence of vectors
+    (returned as a list) or an array (..., K, 3) (returned as an array)."""
+    frame = local_frame(n, v)
+    local = [frame_coordinates(frame, q - p) for q in _vectors(points)]
+    if not isinstance(points, (list, tuple)):
+        local = np.stack(local, axis=-2)
+    return local, op.dot(frame[2], op.normalize(v))
 
 
 def transform(minv, points):
-    """Minv (..., 3, 3) applied to points (..., K, 3)."""
+    """Minv (..., 3, 3) applied to points (..., K, 3) (numpy; shader code uses ``matrix.transform_packed``)."""
     return np.einsum("...ij,...kj->...ki", minv, points)
 
 
@@ -82,11 +138,17 @@ def transform(minv, points):
 # theta = pi and under-weights nearly antipodal edges (a light seen almost edge-on through the
 # shading point, or squashed by a near-singular Minv: up to 8x too dark in tests); here
 # sin^2(theta) = |v1 x v2|^2, the squared length of the cross product the edge vector needs anyway.
+# The fit's seven-digit coefficients are rounded to float32 here, as the GLSL source and Blender's
+# sockets (core/ir constants) hold them, so numpy and node evaluation use the same numbers.
+_FIT_A, _FIT_B, _FIT_C, _FIT_D, _FIT_E = (float(np.float32(x)) for x in
+                                          (0.8543985, 0.4965155, 0.0145206, 3.4175940, 4.1616724))
+
+
 def edge_factor(x, sin2):
     """theta / (2 pi sin(theta)) for x = cos(theta), sin2 = sin^2(theta), from the rational fit."""
-    y = np.abs(x)
-    fit = (0.8543985 + (0.4965155 + 0.0145206 * y) * y) / (3.4175940 + (4.1616724 + y) * y)
-    return op.select(x < 0.0, 0.5 * op.inverse_sqrt(sin2, EDGE_SIN2_MIN) - fit, fit)
+    y = op.absolute(x)
+    fit = (_FIT_A + (_FIT_B + _FIT_C * y) * y) / (_FIT_D + (_FIT_E + y) * y)
+    return op.select(op.less(x, 0.0), 0.5 * op.inverse_sqrt(sin2, EDGE_SIN2_MIN) - fit, fit)
 
 
 def edge_weight(v1, v2):
@@ -97,7 +159,7 @@ def edge_weight(v1, v2):
 
 def edge_vector(v1, v2):
     """Vector form factor of the great-circle arc from unit v1 to unit v2 (fitted edge factor)."""
-    return op.cross(v1, v2) * edge_weight(v1, v2)[..., None]
+    return op.scale(op.cross(v1, v2), edge_weight(v1, v2))
 
 
 # Arvo 1994 / Heitz et al. 2016 eq. 11: the exact edge term theta n / (2 pi) with n the unit normal
@@ -105,11 +167,11 @@ def edge_vector(v1, v2):
 # short edges).
 def edge_weight_exact(v1, v2):
     c = op.length(op.cross(v1, v2))
-    return op.safe_div(np.arctan2(c, op.dot(v1, v2)), c) * _INV_2PI
+    return op.safe_div(op.atan2(c, op.dot(v1, v2)), c) * _INV_2PI
 
 
 def edge_vector_exact(v1, v2):
-    return op.cross(v1, v2) * edge_weight_exact(v1, v2)[..., None]
+    return op.scale(op.cross(v1, v2), edge_weight_exact(v1, v2))
 
 
 def _next(points):
@@ -121,29 +183,48 @@ def _next(points):
 # (an identity: v_i x v_(i+1) = (v_i - o) x (v_(i+1) - o) + o x (v_(i+1) - v_i)).  For a light of
 # angular size s, the plain sum adds O(s) terms into an O(s^2) result (float32 relative error
 # ~ 1e-7 / s^2; measured up to 175% for s ~ 3e-5 .. 1e-3 rad); here every term is O(s^2) or its
-# sum cancels exactly, and the error is ~ 1e-7 / s (0.5% there).  Only differences and crosses.
+# sum cancels exactly, and the error is ~ 1e-7 / s (0.5% there).  Only differences and crosses;
+# the first and last terms of the first sum are zero and left out.
 def vector_form_factor(unit_points, exact=False):
-    """F = sum over the closed polygon's edges of the edge vectors; unit_points (..., K, 3)."""
-    nxt = _next(unit_points)
-    w = (edge_weight_exact if exact else edge_weight)(unit_points, nxt)[..., None]
-    origin = unit_points[..., :1, :]
-    area_part = np.sum(w * op.cross(unit_points - origin, nxt - origin), axis=-2)
-    return area_part + op.cross(origin[..., 0, :], np.sum(w * (nxt - unit_points), axis=-2))
+    """F = sum over the closed polygon's edges of the edge vectors; unit_points: K unit vectors
+    (a sequence, or an array (..., K, 3))."""
+    pts = _vectors(unit_points)
+    nxt = pts[1:] + pts[:1]
+    weight = edge_weight_exact if exact else edge_weight
+    w = [weight(a, b) for a, b in zip(pts, nxt)]
+    origin = pts[0]
+    d = [q - origin for q in pts]
+    area_part = _sum([op.scale(op.cross(d[i], d[i + 1]), w[i]) for i in range(1, len(pts) - 1)])
+    flow = _sum([op.scale(b - a, wi) for a, b, wi in zip(pts, nxt, w)])
+    return area_part + op.cross(origin, flow)
 
 
 def light_normal(points):
     """Newell's normal sum_i p_i x p_(i+1) (twice the vector area of a planar polygon), summed as
-    sum_i (p_i - p_0) x (p_(i+1) - p_0) (the same, without cancellation for small lights)."""
-    d = points - points[..., :1, :]
-    return np.sum(op.cross(d, _next(d)), axis=-2)
+    sum_i (p_i - p_0) x (p_(i+1) - p_0) (the same, without cancellation for small lights); for a
+    quad it is the cross product of the diagonals, (p2 - p0) x (p3 - p1) (the same sum expanded)."""
+    pts = _vectors(points)
+    if len(pts) == 4:
+        return op.cross(pts[2] - pts[0], pts[3] - pts[1])
+    d = [q - pts[0] for q in pts]
+    return _sum([op.cross(d[i], d[i + 1]) for i in range(1, len(pts) - 1)])
 
 
 def behind(points):
-    """True where the origin lies behind the light (p0 . n < 0, ltc_code ``ltc_quad.fs``)."""
-    return op.dot(points[..., 0, :], light_normal(points)) < 0.0
+    """True (1) where the origin lies behind the light (p0 . n < 0, ltc_code ``ltc_quad.fs``)."""
+    pts = _vectors(points)
+    return op.less(op.dot(pts[0], light_normal(pts)), 0.0)
 
 
-# --- horizon clipping (exact reference) ---------------------------------------------------------
+def edge_on(points):
+    """True (1) where the origin lies in the light's plane, to within ``EDGE_ON_SIN``."""
+    pts = _vectors(points)
+    normal = light_normal(pts)
+    side = op.dot(pts[0], normal)
+    return op.less(op.absolute(side), EDGE_ON_SIN * op.length(pts[0]) * op.length(normal))
+
+
+# --- horizon clipping (exact reference, numpy only) ----------------------------------------------
 
 # Sutherland & Hodgman 1974 against the plane z = 0: every edge keeps its part with z >= 0 as a
 # (start, end) pair; edges entirely below are replaced by a repeat of the previous kept point, so
@@ -176,15 +257,26 @@ def _as_float(minv, corners):
 
 # Hill & Heitz 2017 (ltc_code ``ltc_quad.fs``, clipless branch; ltc.md §1.5): |F| and z = F.z/|F|;
 # behind the light z flips (two-sided) or the light is dark (one-sided); horizon from the sphere table.
-def _integral_clipless(transformed, two_sided, table):
-    f = vector_form_factor(op.normalize(transformed))
+def polygon_integral_clipless(points, two_sided, sphere_table=None):
+    """Clipless integral of the clamped cosine over a polygon already transformed by Minv (K vectors,
+    a sequence or an (..., K, 3) array).  ``two_sided``: bool or 0/1 (an Expr when traced);
+    ``sphere_table``: see ``sphere_table.clipped_sphere_integral`` (an op.Lut when traced)."""
+    pts = _vectors(points)
+    f = vector_form_factor([op.normalize(q) for q in pts])
     length = op.length(f)
-    z = op.safe_div(f[..., 2], length)
-    back = behind(transformed)
+    z = op.safe_div(op.component(f, 2), length)
+    back = behind(pts)
     z = op.select(back, -z, z)
     # |F| <= 1 for any spherical region; the clamp removes the edge fit's excess near |F| = 1
-    value = spheres.clipped_sphere_integral(op.saturate(length), z, table)
-    return value if two_sided else op.select(back, 0.0, value).astype(value.dtype)
+    value = spheres.clipped_sphere_integral(op.saturate(length), z, sphere_table)
+    return op.select(edge_on(pts), 0.0, op.select(back, value * two_sided, value))
+
+
+def ltc_polygon_integral_packed(c, corners, two_sided=False, sphere_table=None):
+    """Clipless integral of the LTC with packed entries c = (c0, c1, c2, c3) over the polygon
+    ``corners`` (K vectors in the local frame, relative to the shading point); traceable."""
+    return polygon_integral_clipless([matrix.transform_packed(c, q) for q in _vectors(corners)], two_sided,
+                                     sphere_table)
 
 
 # Heitz et al. 2016 (ltc_code ``ltc_quad.fs``, clipped branch): clip, normalise, exact edges;
@@ -197,11 +289,12 @@ def _integral_clipped(transformed, two_sided):
 
 def ltc_polygon_integral(minv, corners, two_sided=False, sphere_table=None, method="clipless"):
     """Integral of the normalised LTC ``minv`` (..., 3, 3) over the polygon ``corners`` (..., K, 3)
-    (local frame, relative to the shading point, ordered as in the module docstring)."""
+    (local frame, relative to the shading point, ordered as in the module docstring); numpy.
+    ``sphere_table``: None (the analytic table), an (H, W) table or an op.Lut."""
     minv, corners = _as_float(minv, corners)
     transformed = transform(minv, corners)
     if method == "clipless":
-        value = _integral_clipless(transformed, two_sided, sphere_table)
+        value = np.asarray(polygon_integral_clipless(transformed, two_sided, sphere_table))
     elif method == "clipped":
         value = _integral_clipped(transformed, two_sided)
     else:
@@ -220,4 +313,37 @@ def ltc_polygon_vector_form_factor(minv, corners):
     """Vector form factor F of the transformed, unclipped polygon (fitted edges): F.z is the exact
     LTC integral when the transformed polygon lies above the horizon (used by tests)."""
     minv, corners = _as_float(minv, corners)
-    return vector_form_factor(op.normalize(transform(minv, corners)))
+    return vector_form_factor([op.normalize(q) for q in _vectors(transform(minv, corners))])
+
+
+# --- the node function -------------------------------------------------------------------------
+
+def _quad_integral_node(**inputs):
+    c = tuple(inputs[f"c{i}"] for i in range(4))
+    corners = [inputs[f"p{i}"] for i in range(4)]
+    sphere = lookup.default_ltc_tables().sphere_table()
+    return {"Integral": ltc_polygon_integral_packed(c, corners, inputs["Two Sided"], sphere)}
+
+
+_C_TIPS = {"c0": "Minv[0][0] (R of the LTC matrix table)", "c1": "Minv[2][0] (G of the LTC matrix table)",
+           "c2": "Minv[0][2] (B of the LTC matrix table)", "c3": "Minv[2][2] (A of the LTC matrix table)"}
+
+#: Inputs shared by the LTC integral node functions: the packed inverse matrix and the sidedness.
+LTC_MATRIX_SOCKETS = {name: Socket("float", 1.0 if name in ("c0", "c3") else 0.0, description=tip + "; "
+                                   "Minv = [[c0, 0, c2], [0, 1, 0], [c1, 0, c3]]")
+                      for name, tip in _C_TIPS.items()}
+TWO_SIDED_SOCKET = factor(0.0, "1: the light emits on both sides; 0: only on the side away from which "
+                               "its normal points")
+
+#: Integral of an LTC over a quad light (Heitz et al. 2016; clipless, Hill & Heitz 2017): one node group.
+LTC_QUAD_INTEGRAL = NodeFunction(
+    "RTL LTC Quad Integral", _quad_integral_node,
+    inputs=dict(LTC_MATRIX_SOCKETS, **{
+        f"p{i}": vector(f"Corner {i} of the quad in the local shading frame (T1, T2, N), relative to the "
+                        "shading point; (p1 - p0) x (p3 - p0) points away from the lit side", "XYZ")
+        for i in range(4)}, **{"Two Sided": TWO_SIDED_SOCKET}),
+    outputs={"Integral": Socket("float", 0.0, 0.0, 1.0, "FACTOR",
+                                "Integral of the normalised LTC over the light, horizon-clipped (sphere table): "
+                                "multiply by the lobe's magnitude")},
+    description="LTC integral over a quad light (Heitz et al. 2016, clipless form of Hill & Heitz 2017)")
+

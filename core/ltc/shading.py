@@ -1,62 +1,85 @@
-"""Area-light shading with LTCs: the talk's combinations, evaluated in numpy.
+"""Area-light shading with LTCs: the talk's combinations, for numpy and for shader nodes.
 
 Every function returns outgoing radiance per unit emitted radiance of the light (multiply by
-the light's radiance), vectorised over shading points.  Geometry is world-space: shading
-point ``p``, unit normal ``n``, unit view ``v`` (towards the eye), and a light built with
-``QuadLight`` or ``DiskLight``.  ``tables`` is a ``core.lut.lookup.LtcTables``.
+the light's radiance).  Geometry is world-space: shading point ``p``, unit normal ``n``, unit
+view ``v`` (towards the eye), and a light built with ``QuadLight`` or ``DiskLight``; ``tables``
+is a ``core.lut.lookup.LtcTables``.  Written with ``core.shading_ops`` only: called with numpy
+arrays (vectors = (..., 3) arrays, vectorised over shading points) it computes; called with
+``core.ir.Expr`` inputs (``core.ir.trace``) it builds the node graph, where the LTC table
+lookups are ``lut`` nodes and each light integral is one call of ``polygon.LTC_QUAD_INTEGRAL`` /
+``disk.LTC_DISK_INTEGRAL`` (a nested node group).  The local frame is computed once per
+(n, v) when traced (hash-consing shares it between lobes).
+
+The integrals read the sphere table from ``lookup.default_ltc_tables()`` (``ltc_ggx_mag``,
+channel A: the same table in every LUT folder); ``tables`` gives the lobes' own tables.
 """
 from __future__ import annotations
 
+import functools
+import operator
 from dataclasses import dataclass
-
-import numpy as np
 
 from .. import diffuse, multiscatter
 from .. import shading_ops as op
-from . import disk, matrix, polygon
+from . import disk, polygon
 
 #: The talk's Disney sheen uses the CoD diffuse tables at this roughness (smoothness 0.5).
 SHEEN_TABLE_ROUGHNESS = 0.5
 
+#: Packed entries (c0, c1, c2, c3) of the identity Minv (Lambert: the exact form factor).
+IDENTITY = (1.0, 0.0, 0.0, 1.0)
+
 
 @dataclass(frozen=True)
 class QuadLight:
-    """A planar quad: corners (..., 4, 3) in order.  One-sided lights emit on the side away from
-    which (c1 - c0) x (c3 - c0) points (corners clockwise seen from the lit side; ltc_code's
-    convention, ``polygon.behind``)."""
-    corners: np.ndarray
-    two_sided: bool = False
+    """A planar quad: four corners in order, as a sequence of vectors (arrays (..., 3) or Expr vectors)
+    or an array (..., 4, 3).  One-sided lights emit on the side away from which (c1 - c0) x (c3 - c0)
+    points (corners clockwise seen from the lit side; ltc_code's convention, ``polygon.behind``).
+    ``two_sided``: bool, or a 0/1 float / Expr."""
+    corners: object
+    two_sided: object = False
 
-    def integral(self, minv, p, n, v, sphere_table):
-        local, _ = polygon.to_local(self.corners, p, n, v)
-        return polygon.ltc_quad_integral(minv, local, self.two_sided, sphere_table)
+    def corner_list(self):
+        corners = polygon._vectors(self.corners)
+        if len(corners) != 4:
+            raise ValueError("a quad light needs four corners")
+        return corners
+
+    def center(self):
+        return op.scale(functools.reduce(operator.add, self.corner_list()), 0.25)
+
+    def integral(self, c, frame, p):
+        """LTC integral for packed Minv entries c in the shading frame ``frame`` (``polygon.local_frame``)."""
+        local = [polygon.frame_coordinates(frame, q - p) for q in self.corner_list()]
+        args = {f"c{i}": c[i] for i in range(4)}
+        args.update({f"p{i}": local[i] for i in range(4)})
+        args["Two Sided"] = self.two_sided
+        return polygon.LTC_QUAD_INTEGRAL(**args)["Integral"]
 
 
 @dataclass(frozen=True)
 class DiskLight:
-    """An ellipse (disk when |axis_u| = |axis_v|): centre and semi-axis vectors (..., 3).  One-sided
-    lights emit on the side away from which axis_u x axis_v points (as ``QuadLight``)."""
-    center: np.ndarray
-    axis_u: np.ndarray
-    axis_v: np.ndarray
-    two_sided: bool = False
+    """An ellipse (disk when |axis_u| = |axis_v|): centre and semi-axis vectors (arrays (..., 3) or Expr
+    vectors).  One-sided lights emit on the side away from which axis_u x axis_v points (as ``QuadLight``)."""
+    center: object
+    axis_u: object
+    axis_v: object
+    two_sided: object = False
 
-    def integral(self, minv, p, n, v, sphere_table):
-        t1, t2, nn = polygon.local_frame(n, v)
-
-        def local(x, is_point):
-            d = np.asarray(x) - (np.asarray(p) if is_point else 0.0)
-            return np.stack([op.dot(d, t1), op.dot(d, t2), op.dot(d, nn)], axis=-1)
-
-        return disk.ltc_disk_integral(minv, local(self.center, True), local(self.axis_u, False),
-                                      local(self.axis_v, False), self.two_sided, sphere_table)
+    def integral(self, c, frame, p):
+        args = {f"c{i}": c[i] for i in range(4)}
+        args.update({"Center": polygon.frame_coordinates(frame, self.center - p),
+                     "Axis U": polygon.frame_coordinates(frame, self.axis_u),
+                     "Axis V": polygon.frame_coordinates(frame, self.axis_v),
+                     "Two Sided": self.two_sided})
+        return disk.LTC_DISK_INTEGRAL(**args)["Integral"]
 
 
 def lobe_integral(tables, prefix, light, p, n, v, roughness):
     """(LTC integral, magnitude, fresnel) of one table's lobe at this shading point."""
     mu = op.saturate(op.dot(n, v))
     packed, magnitude, fresnel = tables.lookup(prefix, mu, roughness)
-    value = light.integral(matrix.unpack_inverse(packed), p, n, v, tables.sphere_table(prefix))
+    value = light.integral(packed, polygon.local_frame(n, v), p)
     return value, magnitude, fresnel
 
 
@@ -69,25 +92,25 @@ def ggx_specular(tables, light, p, n, v, roughness, f0, f90=1.0):
 # The talk, "No implementation for multiscattering specular": scale f_ss by Turquin's
 # 1 + F0 (1 - E)/E or by the approximation to Fdez-Aguera, E = the GGX table's magnitude.
 def ggx_specular_multiscatter(tables, light, p, n, v, roughness, f0, method="turquin"):
+    if method not in ("turquin", "fdez_aguera"):
+        raise ValueError(f"unknown multiscattering method {method!r}")
     value, magnitude, fresnel = lobe_integral(tables, "ltc_ggx", light, p, n, v, roughness)
     single = value * (f0 * (magnitude - fresnel) + fresnel)
     if method == "turquin":
         return single * multiscatter.turquin_compensation(f0, magnitude)
-    if method == "fdez_aguera":
-        return single * multiscatter.fdez_aguera_area_scale(f0, magnitude)
-    raise ValueError(f"unknown multiscattering method {method!r}")
+    return single * multiscatter.fdez_aguera_area_scale(f0, magnitude)
 
 
 # The talk, "LTCs for multiscattering diffuse": the CoD WWII lobe's own LTC (albedo 1 in the table).
 def cod_diffuse(tables, light, p, n, v, roughness, albedo):
     value, magnitude, _ = lobe_integral(tables, "ltc_cod_diffuse", light, p, n, v, roughness)
-    return np.asarray(albedo) * magnitude * value
+    return magnitude * value * albedo
 
 
 # The talk, "LTCs for Ashikhmin cloth": the cloth lobe's LTC (sheen colour 1 in the table).
 def ashikhmin_cloth(tables, light, p, n, v, roughness, sheen_color):
     value, magnitude, _ = lobe_integral(tables, "ltc_cloth", light, p, n, v, roughness)
-    return np.asarray(sheen_color) * magnitude * value
+    return magnitude * value * sheen_color
 
 
 def disney_sheen(tables, light, p, n, v, sheen_color):
@@ -95,25 +118,23 @@ def disney_sheen(tables, light, p, n, v, sheen_color):
     CoD diffuse table at r = 0.5 with that table's LTC.  The CoD lobe carries 1/pi and Disney
     sheen (1 - l.h)^5 does not (Burley 2012), hence the factor pi; the error of the whole
     approximation is measured in docs/benchmarks/ltc.md."""
-    r = np.full(np.shape(op.dot(n, v)), SHEEN_TABLE_ROUGHNESS)
-    value, _, fresnel = lobe_integral(tables, "ltc_cod_diffuse", light, p, n, v, r)
-    return np.asarray(sheen_color) * np.pi * fresnel * value
+    value, _, fresnel = lobe_integral(tables, "ltc_cod_diffuse", light, p, n, v, SHEEN_TABLE_ROUGHNESS)
+    return fresnel * value * sheen_color * 3.141592653589793
 
 
 def lambert(tables, light, p, n, v, albedo):
-    """Lambert: the identity LTC gives the exact form factor (Heitz et al. 2016, section 5)."""
-    identity = np.broadcast_to(np.eye(3), np.shape(op.dot(n, v)) + (3, 3))
-    value = light.integral(identity, p, n, v, tables.sphere_table())
-    return np.asarray(albedo) * value
+    """Lambert: the identity LTC gives the exact form factor (Heitz et al. 2016, section 5).
+    ``tables`` is unused (kept for a uniform signature)."""
+    return light.integral(IDENTITY, polygon.local_frame(n, v), p) * albedo
 
 
 def light_center(light):
-    return light.center if isinstance(light, DiskLight) else np.mean(light.corners, axis=-2)
+    return light.center if isinstance(light, DiskLight) else light.center()
 
 
 # The talk, "How to combine LTCs with wrapped diffuse": tilt N towards the light's centre
 # (WrappedNormal), integrate the clamped cosine about the tilted normal, normalise by 1/(1 + w).
 def wrapped_diffuse(tables, light, p, n, v, albedo, wrap):
-    to_light = op.normalize(light_center(light) - np.asarray(p))
+    to_light = op.normalize(light_center(light) - p)
     n_wrapped = diffuse.wrapped_normal(n, to_light, wrap)
     return lambert(tables, light, p, n_wrapped, v, albedo) / (1.0 + op.saturate(wrap))

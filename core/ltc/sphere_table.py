@@ -10,7 +10,9 @@ with the z axis along i (texture u) and the |F| axis along j (texture v):
     z = 2 i/(N - 1) - 1 (cosine of the cap axis elevation), len = j/(N - 1) (= |F|),
     value = clipped_form_factor(z, len) / len in [0, 1], and max(z, 0) at len = 0.
 A shader reads it at u = lut_coordinate(z/2 + 1/2), v = lut_coordinate(|F|) and multiplies
-by |F| (``clipped_sphere_integral``).
+by |F| (``clipped_sphere_integral``).  Traced shader code reads channel A of the ``ltc_ggx_mag``
+image (``core.lut.lookup.default_ltc_tables().sphere_table()``, an ``op.Lut``); numpy callers may
+also pass a bare (H, W) table, or nothing for the analytic table of ``default_table``.
 """
 from __future__ import annotations
 
@@ -19,7 +21,10 @@ import functools
 import numpy as np
 
 from .. import shading_ops as op
-from ..lut.lookup import lut_coordinate, sample_bilinear
+from ..ir.expr import is_expr
+
+#: Channel of a ``*_mag`` LTC table that holds the sphere table (docs/luts.md).
+SPHERE_CHANNEL = 3
 
 #: Default table size (64 x 64, the LTC tables' size, ltc.md §5.2).
 SIZE = 64
@@ -40,8 +45,8 @@ def cap_projected_solid_angle(z, length):
     length = op.saturate(length)
     c = op.sqrt(1.0 - length)
     q = op.sqrt(length - z * z)
-    az = np.abs(z)
-    straddling = (0.5 * np.pi - np.arctan2(c, q) - c * q - az * length * np.arctan2(q, az * c))
+    az = op.absolute(z)
+    straddling = (0.5 * np.pi - op.atan2(c, q) - c * q - az * length * op.atan2(q, az * c))
     unclipped = np.pi * op.maximum(z, 0.0) * length
     return unclipped + op.select(z * z < length, straddling, 0.0)
 
@@ -72,15 +77,34 @@ def default_table(size=SIZE):
     return table
 
 
+def _sphere_lut(table, traced):
+    """(Lut, channel) for a sphere table given as a Lut (channel A of a ``*_mag`` table), an (H, W)
+    array, or None (the analytic table; numpy only)."""
+    if isinstance(table, op.Lut):
+        return table, SPHERE_CHANNEL
+    if traced:
+        raise TypeError("traced code reads the sphere table from an image: pass an op.Lut "
+                        "(core.lut.lookup.default_ltc_tables().sphere_table())")
+    table = default_table() if table is None else np.asarray(table)
+    if table.ndim == 3:
+        return op.Lut("sphere_table", table), SPHERE_CHANNEL
+    return op.Lut("sphere_table", table[..., None]), 0
+
+
 # Hill & Heitz 2016/2017 (ltc_code ``ltc_quad.fs``, ltc.md §1.5): clipped integral of a light with
 # vector form factor F ~ |F| * table(z/2 + 1/2, |F|), z = F.z / |F|, bilinear at texel centres.
+# The coordinates are lut_coordinate's (x (N - 1) + 0.5) / N folded into one multiply-add each,
+# without its clamp to [0, 1]: EXTEND clamps to the edge texels, which is the same lookup.
 def clipped_sphere_integral(length, z, table=None):
-    """|F| times the table's ratio at (z, |F|): the horizon-clipped form factor of the equivalent cap."""
-    length, z = np.asarray(length), np.asarray(z)
-    dtype = np.result_type(length.dtype, z.dtype, np.float32)
-    table = default_table() if table is None else np.asarray(table)
-    size_v, size_u = table.shape[:2]
-    u = lut_coordinate(z * 0.5 + 0.5, size_u)
-    v = lut_coordinate(length, size_v)
-    ratio = sample_bilinear(table.reshape(size_v, size_u, 1), u, v)[..., 0]
-    return (length * ratio).astype(dtype, copy=False)
+    """|F| times the table's ratio at (z, |F|): the horizon-clipped form factor of the equivalent cap.
+    ``length``, ``z`` arrays or Exprs; ``table`` as in ``_sphere_lut`` (a Lut when traced)."""
+    traced = is_expr(length, z)
+    lut, channel = _sphere_lut(table, traced)
+    size_v, size_u = lut.table.shape[:2]
+    u = z * (0.5 * (size_u - 1) / size_u) + 0.5
+    v = length * ((size_v - 1) / size_v) + 0.5 / size_v
+    value = length * op.lut_sample(lut, u, v, channel)
+    if traced:
+        return value
+    return np.asarray(value).astype(np.result_type(np.asarray(length).dtype, np.asarray(z).dtype, np.float32),
+                                    copy=False)

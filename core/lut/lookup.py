@@ -5,14 +5,22 @@ centre at u = (i + 0.5)/W, and coordinates outside the centres clamp to the edge
 (../shared/reference/blender_addon.md §3.2).  ``lut_coordinate`` maps a table parameter in
 [0, 1] onto the texel centres, so node values are returned exactly and the table is
 reconstructed as a piecewise-linear function of its parameters.
+
+``LtcTables.lookup`` works on numpy arrays and on IR expressions (``op.lut_sample`` with
+``op.Lut`` objects named by catalog table names).  Traced functions that cannot receive a tables
+object (node functions) read the process-wide default: ``default_ltc_tables()`` /
+``default_energy_tables()``, loaded once from ``active_lut_dir()``: ``catalog.default_lut_dir()``
+or the folder given to ``use_lut_dir`` (a plain call, or ``with use_lut_dir(path):``).
 """
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import numpy as np
 
 from .. import shading_ops as op
+from ..ir.expr import is_expr
 from . import catalog, exr_io
 
 
@@ -84,19 +92,100 @@ class LtcTables:
 
     def __init__(self, lut_dir=None, prefixes=None):
         lut_dir = Path(lut_dir) if lut_dir is not None else catalog.default_lut_dir()
+        self.lut_dir = lut_dir
         self.tables = {}
         for prefix in prefixes or catalog.LTC_LOBES:
             for suffix in ("_inv", "_mag"):
                 spec = catalog.TABLES[prefix + suffix]
                 self.tables[spec.name], _ = exr_io.read_table(lut_dir / spec.filename, spec.name, spec.shape)
+        #: table name -> op.Lut (one Image Texture per table in nodes)
+        self.luts = {name: op.Lut(name, table) for name, table in self.tables.items()}
 
     def lookup(self, prefix, mu, roughness):
-        """(packed Minv (..., 4), magnitude (...), fresnel (...)) at (mu, r)."""
+        """((c0, c1, c2, c3), magnitude, fresnel) at (mu, r): the packed Minv entries (``matrix``)
+        and the lobe's magnitude and Fresnel channels.  Arrays or Exprs (one ``lut`` node per channel)."""
         u, v = ltc_lut_uv(mu, roughness)
-        packed = sample_bilinear(self.tables[prefix + "_inv"], u, v)
-        mag = sample_bilinear(self.tables[prefix + "_mag"], u, v)
-        return packed, mag[..., 0], mag[..., 1]
+        inv, mag = self.luts[prefix + "_inv"], self.luts[prefix + "_mag"]
+        if is_expr(u, v):
+            return (tuple(op.lut_sample(inv, u, v, i) for i in range(4)),
+                    op.lut_sample(mag, u, v, 0), op.lut_sample(mag, u, v, 1))
+        packed = sample_bilinear(inv.table, u, v)
+        m = sample_bilinear(mag.table, u, v)
+        return tuple(packed[..., i] for i in range(4)), m[..., 0], m[..., 1]
 
     def sphere_table(self, prefix="ltc_ggx"):
-        """The horizon-clipped sphere table stored in the spare channel, (H, W) [len axis, z axis]."""
-        return self.tables[prefix + "_mag"][..., 3]
+        """The horizon-clipped sphere table: the ``op.Lut`` of the ``prefix_mag`` table, whose channel A
+        (``core.ltc.sphere_table.SPHERE_CHANNEL``) holds it on its own axes; every ``*_mag`` table
+        carries the same one, so shader code reads ``ltc_ggx_mag``'s and one image serves all lobes."""
+        return self.luts[prefix + "_mag"]
+
+
+# --- process-wide defaults (for node functions, which cannot receive a tables object) ---------------
+
+_lock = threading.Lock()
+_state = {"dir": None, "ltc": None, "energy": None}
+_hooks = []
+
+
+def active_lut_dir():
+    """The folder the defaults read: the one given to ``use_lut_dir``, else the shipped ``luts/``."""
+    return Path(_state["dir"]) if _state["dir"] is not None else catalog.default_lut_dir()
+
+
+current_lut_dir = active_lut_dir
+
+
+def _set_lut_dir(path):
+    with _lock:
+        _state.update(dir=None if path is None else Path(path), ltc=None, energy=None)
+    from ..ir.functions import invalidate_all
+
+    invalidate_all()          # traced node-function bodies hold the tables they were traced with
+    for hook in list(_hooks):
+        hook()
+
+
+class _LutDirChange:
+    """Returned by ``use_lut_dir``: the change is already made; as a context manager it is undone
+    (the previous folder restored) on exit."""
+
+    def __init__(self, previous):
+        self.previous = previous
+
+    def __enter__(self):
+        return active_lut_dir()
+
+    def __exit__(self, *exc):
+        _set_lut_dir(self.previous)
+        return False
+
+
+def use_lut_dir(path):
+    """Point the default tables at ``path`` (None: back to the shipped folder), now; cached tables are
+    dropped and the registered hooks run (node functions forget bodies traced with the old tables).
+    ``with use_lut_dir(path): ...`` restores the previous folder afterwards."""
+    previous = _state["dir"]
+    _set_lut_dir(path)
+    return _LutDirChange(previous)
+
+
+def on_lut_dir_change(hook):
+    """Register ``hook()`` to run whenever ``use_lut_dir`` is called; returns ``hook`` (a decorator)."""
+    _hooks.append(hook)
+    return hook
+
+
+def default_ltc_tables():
+    """``LtcTables`` of ``active_lut_dir()``, loaded once and shared."""
+    with _lock:
+        if _state["ltc"] is None:
+            _state["ltc"] = LtcTables(active_lut_dir())
+        return _state["ltc"]
+
+
+def default_energy_tables():
+    """``EnergyTables`` of ``active_lut_dir()``, loaded once and shared."""
+    with _lock:
+        if _state["energy"] is None:
+            _state["energy"] = EnergyTables(active_lut_dir())
+        return _state["energy"]

@@ -121,7 +121,7 @@ def render_group_outputs(ng, inputs, output_name):
             nt.links.new(t.outputs["Color"], group.inputs[k])
 
         out_socket = group.outputs[output_name]
-        is_vector = out_socket.type == "VECTOR"
+        is_vector = out_socket.type in ("VECTOR", "RGBA")      # colours read back as RGB
         emission = nt.nodes.new("ShaderNodeEmission")
         emission.inputs["Strength"].default_value = 1.0
         emission.location = (1000, 0)

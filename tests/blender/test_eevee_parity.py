@@ -24,7 +24,7 @@ _HERE = Path(__file__).resolve().parent
 if str(_HERE) not in sys.path:
     sys.path.insert(0, str(_HERE))
 
-from eevee_parity import compare, eevee_available, render_engines  # noqa: E402
+from engine_parity import compare, eevee_available, render_engines  # noqa: E402
 
 pytestmark = pytest.mark.blender
 

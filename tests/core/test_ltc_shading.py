@@ -12,7 +12,8 @@ N = np.array([0.0, 0.0, 1.0])
 
 @pytest.fixture(scope="module")
 def ltc_tables(lut_dir):
-    return lookup.LtcTables(lut_dir)
+    with lookup.use_lut_dir(lut_dir):      # the integrals' node functions read the default tables
+        yield lookup.LtcTables(lut_dir)
 
 
 def view(theta_deg):

@@ -31,6 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _bootstrap  # noqa: E402,F401
+
 from rt_lookdev.addon.render_setup import (configure_cycles_measurement, configure_eevee_measurement,
                                            eevee_texture_filtering)
 
@@ -186,3 +189,51 @@ def eevee_available(timeout=120):
                              f"{proc.returncode}): {tail[-300:]}")
     _PROBE["result"] = result
     return result
+
+
+def render_cycles_passes(scene, resolution=(64, 64), path=None):
+    """Cycles, 1 sample at pixel centres, emission only: {"Combined": (H, W, 3), "Position": ...,
+    "Normal": ..., "seconds": s} (world space, row 0 = top; background pixels have Normal 0)."""
+    import bpy
+    import OpenEXR
+
+    w, h = (resolution, resolution) if np.isscalar(resolution) else resolution
+    tmp = tempfile.TemporaryDirectory(prefix="rtl-passes-") if path is None else None
+    folder = Path(tmp.name if tmp else path)
+    folder.mkdir(parents=True, exist_ok=True)
+    exr = folder / "cycles_passes.exr"
+    try:
+        configure_engine(scene, "CYCLES")
+        _output_settings(scene, w, h, exr)
+        vl = scene.view_layers[0]
+        vl.use_pass_position = vl.use_pass_normal = True
+        s = scene.render.image_settings
+        s.media_type = "MULTI_LAYER_IMAGE"
+        s.file_format = "OPEN_EXR_MULTILAYER"
+        s.color_depth = "32"
+        t0 = time.perf_counter()
+        bpy.ops.render.render(write_still=True, scene=scene.name)
+        seconds = time.perf_counter() - t0
+        with OpenEXR.File(str(exr), separate_channels=True) as f:
+            ch = {n: np.array(c.pixels) for p in f.parts for n, c in p.channels.items()}
+        prefix = f"{vl.name}."
+
+        def get(name, comps):
+            return np.stack([ch[f"{prefix}{name}.{c}"] for c in comps], axis=-1).astype(np.float32)
+
+        return {"Combined": get("Combined", "RGB"), "Position": get("Position", "XYZ"),
+                "Normal": get("Normal", "XYZ"), "seconds": seconds}
+    finally:
+        if tmp is not None:
+            tmp.cleanup()
+
+
+def camera_incoming(scene, position):
+    """Unit directions from shading points towards the camera (Geometry > Incoming)."""
+    cam = scene.camera
+    mw = np.array(cam.matrix_world, dtype=np.float64)
+    if cam.data.type == "ORTHO":
+        forward = -mw[:3, 2]
+        return np.broadcast_to(-forward / np.linalg.norm(forward), np.shape(position)).astype(np.float64)
+    d = mw[:3, 3] - np.asarray(position, np.float64)
+    return d / np.maximum(np.linalg.norm(d, axis=-1, keepdims=True), 1e-30)
