@@ -22,7 +22,7 @@ MATH_OPS = {
     "log2": "LOGARITHM", "minimum": "MINIMUM", "maximum": "MAXIMUM", "less_than": "LESS_THAN",
     "greater_than": "GREATER_THAN", "absolute": "ABSOLUTE", "arccosine": "ARCCOSINE",
     "arcsine": "ARCSINE", "sine": "SINE", "cosine": "COSINE", "tangent": "TANGENT",
-    "arctan2": "ARCTAN2",
+    "arctan2": "ARCTAN2", "floor": "FLOOR",
 }
 
 #: IR operation -> (ShaderNodeVectorMath.operation, input socket indices, output socket name)
@@ -68,6 +68,8 @@ def lut_image(table, lut_dir=None):
         image.name = name
         image.colorspace_settings.name = "Non-Color"
         image.alpha_mode = "CHANNEL_PACKED"
+        # full float on the GPU: EEVEE would otherwise upload half floats (LTC entries reach 1e8)
+        image.use_half_precision = False
         image.pack()
         image.use_fake_user = True
     return image
@@ -297,10 +299,10 @@ class _Emitter:
                     place(bn, col, "separate")
                 produced[node.id] = bn.outputs[_COMPONENTS[op]]
                 continue
-            elif op == "lut":
+            elif op in ("lut", "texel"):
                 table, channel = node.attr("table"), node.attr("channel")
                 u, v = node.args
-                key = (table, u.id, v.id)
+                key = (op, table, u.id, v.id)
                 if key not in textures:
                     uv = nodes.new("ShaderNodeCombineXYZ")
                     feed(uv.inputs[0], u)
@@ -308,7 +310,7 @@ class _Emitter:
                     place(uv, col, "lut uv")
                     tex = nodes.new("ShaderNodeTexImage")
                     tex.image = lut_image(table, self.lut_dir)
-                    tex.interpolation = "Linear"
+                    tex.interpolation = "Linear" if op == "lut" else "Closest"
                     tex.extension = "EXTEND"
                     links.new(uv.outputs[0], tex.inputs["Vector"])
                     place(tex, col, table)

@@ -97,9 +97,7 @@ def build_demo_scene(lut_dir=None, resolution=256):
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
-    world = bpy.data.worlds.new("RTL Demo World")
-    world.color = (0.0, 0.0, 0.0)
-    scene.world = world
+    scene.world = None      # no world light yet (issue 6); a new world would add a grey background
 
     # lights first: the RT Lit groups are built for the scene's lights
     _light(bpy, "Quad Key", "RECTANGLE", 2.0, 1.0, 600.0, (-2.0, -3.0, 2.5), (0.9, 0.0, -0.6),

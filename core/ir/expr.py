@@ -31,7 +31,8 @@ OPS = {
     "exponent": ((FLOAT,), FLOAT), "log2": ((FLOAT,), FLOAT),
     "minimum": ((FLOAT, FLOAT), FLOAT), "maximum": ((FLOAT, FLOAT), FLOAT),
     "less_than": ((FLOAT, FLOAT), FLOAT), "greater_than": ((FLOAT, FLOAT), FLOAT),
-    "absolute": ((FLOAT,), FLOAT), "arccosine": ((FLOAT,), FLOAT), "arcsine": ((FLOAT,), FLOAT),
+    "absolute": ((FLOAT,), FLOAT), "floor": ((FLOAT,), FLOAT),
+    "arccosine": ((FLOAT,), FLOAT), "arcsine": ((FLOAT,), FLOAT),
     "sine": ((FLOAT,), FLOAT), "cosine": ((FLOAT,), FLOAT), "tangent": ((FLOAT,), FLOAT),
     "arctan2": ((FLOAT, FLOAT), FLOAT),
     # Mix node with a float factor: select(c, a, b) = mix(b, a, c) for c in {0, 1}
@@ -39,6 +40,8 @@ OPS = {
     "vselect": ((FLOAT, VECTOR, VECTOR), VECTOR),
     # Image Texture (Linear, EXTEND) at (u, v), one channel: attrs ("table", name), ("channel", 0..3)
     "lut": ((FLOAT, FLOAT), FLOAT),
+    # Image Texture (Closest, EXTEND) at (u, v): the texel (floor(u W), floor(v H)), one channel
+    "texel": ((FLOAT, FLOAT), FLOAT),
     # Combine / Separate XYZ
     "combine": ((FLOAT, FLOAT, FLOAT), VECTOR), "x": ((VECTOR,), FLOAT), "y": ((VECTOR,), FLOAT),
     "z": ((VECTOR,), FLOAT),
@@ -50,6 +53,25 @@ OPS = {
 }
 
 _local = threading.local()
+_FOLDING = {"enabled": True}
+
+
+class folding:
+    """``with folding(False):`` traces without constant folding, identities or dead-branch
+    removal (hash-consing stays): for measuring what folding saves.  Traced node-function bodies
+    are cached, so callers invalidate them around the block (``functions.invalidate_all``)."""
+
+    def __init__(self, enabled):
+        self.enabled, self.previous = bool(enabled), None
+
+    def __enter__(self):
+        self.previous = _FOLDING["enabled"]
+        _FOLDING["enabled"] = self.enabled
+        return self
+
+    def __exit__(self, *exc):
+        _FOLDING["enabled"] = self.previous
+        return False
 
 
 class Graph:
@@ -101,7 +123,7 @@ class Graph:
         args = tuple(self.lift(a) for a in args)
         if len(args) != len(kinds) or any(a.kind != k for a, k in zip(args, kinds)):
             raise TypeError(f"{op}: expected {kinds}, got {tuple(a.kind for a in args)}")
-        folded = _simplify(self, op, args)
+        folded = _simplify(self, op, args) if _FOLDING["enabled"] else None
         if folded is not None:
             return folded
         key = (op, tuple(a.id for a in args), attrs)
@@ -266,7 +288,7 @@ def _const_value(e):
 
 def _simplify(graph, op, args):
     """Constant folding and algebraic identities that hold under Blender's semantics."""
-    if op in ("const", "vconst", "input", "vinput", "lut"):
+    if op in ("const", "vconst", "input", "vinput", "lut", "texel"):
         return None
     if all(a.is_const for a in args):
         from .numpy_backend import apply_op

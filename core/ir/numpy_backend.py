@@ -59,6 +59,7 @@ _SCALAR = {
     "less_than": lambda a, b: (a < b).astype(a.dtype),
     "greater_than": lambda a, b: (a > b).astype(a.dtype),
     "absolute": np.abs,
+    "floor": np.floor,
     "arccosine": lambda a: np.arccos(np.clip(a, -1, 1)),
     "arcsine": lambda a: np.arcsin(np.clip(a, -1, 1)),
     "sine": np.sin,
@@ -109,6 +110,13 @@ def evaluate(outputs, inputs, dtype=np.float32):
             cache[node.id] = dict(zip(names, values))
         elif node.op == "output":
             cache[node.id] = cache[node.args[0].id][node.attr("name")]
+        elif node.op == "texel":
+            u, v = (cache[a.id] for a in node.args)
+            table = np.asarray(node.graph.luts[node.attr("table")])
+            h, w = table.shape[:2]
+            i = np.clip(np.floor(np.asarray(u, np.float64) * w), 0, w - 1).astype(np.int64)
+            j = np.clip(np.floor(np.asarray(v, np.float64) * h), 0, h - 1).astype(np.int64)
+            cache[node.id] = table[j, i][..., node.attr("channel")].astype(dtype)
         elif node.op == "lut":
             from ..lut.lookup import sample_bilinear
 

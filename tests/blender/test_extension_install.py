@@ -141,8 +141,9 @@ def test_install_enable_run_disable_leaves_nothing_behind(extension_zip, tmp_pat
     assert result["default_lut_dir"].startswith(result["installed_dir"])
     assert result["lut_states"] and set(result["lut_states"].values()) == {"ok"}, result["lut_states"]
 
-    # Enabled: the operator and preferences are registered under the extension's name.
-    assert result["enabled_state"]["ops_rtl"] == ["lut_status"]
+    # Enabled: the operators and preferences are registered under the extension's name.
+    assert result["enabled_state"]["ops_rtl"] == ["convert_to_principled", "convert_to_rt_lit", "lut_status",
+                                                  "sync_lights"]
     assert result["prefs_bl_idname"] == MODULE
     assert result["prefs_class"] == "RTL_AddonPreferences"
     assert result["prefs_lut_directory"] == ""

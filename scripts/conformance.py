@@ -16,6 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
+import sys as _sys
+_sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _bootstrap  # noqa: E402,F401
+
 LAST_RENDER_SECONDS = [0.0]
 
 
@@ -24,17 +28,21 @@ def _image(bpy, name, rgb):
     h, w, _ = rgb.shape
     img = bpy.data.images.new(name, w, h, alpha=True, float_buffer=True, is_data=True)
     img.alpha_mode = "CHANNEL_PACKED"
+    img.use_half_precision = False      # EEVEE would upload half floats
     rgba = np.ones((h, w, 4), dtype=np.float32)
     rgba[..., :3] = rgb
     img.pixels.foreach_set(np.flipud(rgba).ravel())    # img.pixels row 0 = bottom row
     return img
 
 
-def _setup_render(scene, w, h, path):
-    from rt_lookdev.addon.render_setup import configure_cycles_measurement
+def _setup_render(scene, w, h, path, engine="CYCLES"):
+    from rt_lookdev.addon.render_setup import configure_cycles_measurement, configure_eevee_measurement
 
-    configure_cycles_measurement(scene, samples=1, seed=0)
-    scene.cycles.max_bounces = 0
+    if engine == "CYCLES":
+        configure_cycles_measurement(scene, samples=1, seed=0)
+        scene.cycles.max_bounces = 0
+    else:
+        configure_eevee_measurement(scene, samples=1, black_world=False)
     r = scene.render
     r.resolution_x, r.resolution_y, r.resolution_percentage = w, h, 100
     r.dither_intensity = 0.0
@@ -57,8 +65,9 @@ def _read_exr(path):
     return np.stack([ch["R"], ch["G"], ch["B"]], axis=-1).astype(np.float32)   # row 0 = top
 
 
-def render_group_outputs(ng, inputs, output_name):
-    """Cycles' value of ``ng``'s output ``output_name`` per pixel for per-pixel ``inputs``.
+def render_group_outputs(ng, inputs, output_name, engine="CYCLES"):
+    """Cycles' (or EEVEE's: ``engine="BLENDER_EEVEE"``) value of ``ng``'s output ``output_name``
+    per pixel for per-pixel ``inputs``.  EEVEE stores half floats and writes 0 for negative values.
 
     ``inputs``: group input name -> float32 array (H, W) (float sockets) or (H, W, 3) (vector).
     Returns float32 (H, W) or (H, W, 3) in the orientation of the inputs.
@@ -137,7 +146,7 @@ def render_group_outputs(ng, inputs, output_name):
             nt.links.new(comb.outputs[0], emission.inputs["Color"])
         mout = nt.nodes.new("ShaderNodeOutputMaterial")
         mout.location = (1200, 0)
-        mout.target = "CYCLES"
+        mout.target = "ALL"
         nt.links.new(emission.outputs[0], mout.inputs["Surface"])
 
         # --- plane exactly filling an orthographic camera ------------------------------------------
@@ -177,9 +186,15 @@ def render_group_outputs(ng, inputs, output_name):
         scene.world = world
 
         path = Path(tmp.name) / "out.exr"
-        _setup_render(scene, w, h, path)
+        _setup_render(scene, w, h, path, engine)
         t0 = time.perf_counter()
-        bpy.ops.render.render(write_still=True)
+        if engine == "CYCLES":
+            bpy.ops.render.render(write_still=True)
+        else:
+            from rt_lookdev.addon.render_setup import eevee_texture_filtering
+
+            with eevee_texture_filtering():
+                bpy.ops.render.render(write_still=True)
         LAST_RENDER_SECONDS[0] = time.perf_counter() - t0
         rgb = _read_exr(path)
         rgb = rgb[:h0, :w0]

@@ -1,0 +1,197 @@
+"""The demo lookdev scene, measured: node counts, Cycles and EEVEE renders, their agreement.
+
+    python scripts/demo_report.py [--out out/report/demo] [--lut-dir DIR] [--resolution 256]
+                                  [--repeats 3] [--skip-eevee]
+
+Builds the demo scene (scripts/build_demo_scene.py), saves it, and reports:
+- node counts of every emitted group (largest group, per RT Lit material flattened), and the
+  IR operations of each RT Lit material with and without folding (constant folding, identities,
+  dead-branch removal);
+- the Cycles render of the RT Lit materials at 1 sample (median of ``repeats`` timed renders);
+- one EEVEE render (headless, Mesa llvmpipe) and its relative error against Cycles where
+  Cycles > 1e-3 (EEVEE's film is half precision and it writes 0 for negative values);
+- PNG previews (Cycles, EEVEE, the error map with its colour bar).
+Writes demo.json and demo.md into --out; exit 1 when EEVEE and Cycles differ by more than the
+acceptance (1e-2 relative at the 99.9th percentile and 5e-2 at the maximum; see README).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _bootstrap  # noqa: E402,F401
+
+REPO = Path(__file__).resolve().parents[1]
+
+EEVEE_P999_TOL = 1e-2
+EEVEE_MAX_TOL = 5e-2
+POSITIVE_FLOOR = 1e-3
+
+
+def _tonemap(rgb):
+    x = np.clip(np.asarray(rgb, np.float64), 0.0, None)
+    return np.clip(x / (1.0 + x), 0.0, 1.0) ** (1 / 2.2)
+
+
+def node_counts(scene_materials):
+    """{"groups": {name: nodes}, "materials": {material: {...}}} for the RT Lit groups in the file."""
+    import bpy
+
+    from rt_lookdev.addon import materials
+    from rt_lookdev.addon.node_emit import flat_tree_node_count, tree_node_counts
+    from rt_lookdev.core.ir import expr
+    from rt_lookdev.core.ir.functions import invalidate_all
+    from rt_lookdev.core.ir.numpy_backend import flat_node_count
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    groups = {}
+    per_features = {}
+    records = [tuple(e.rsplit(":", 1)) for e in bpy.data.node_groups[materials.SCENE_LIGHTS_GROUP]["rtl_lights"]]
+    for ng in bpy.data.node_groups:
+        if materials.FEATURES_KEY not in ng.keys():
+            continue
+        features = Features.from_dict(ng[materials.FEATURES_KEY])
+        counts = tree_node_counts(ng)
+        groups.update(counts)
+        outputs, _, _ = materials._graph_for(features, records)
+        folded = flat_node_count(tuple(outputs.values()))
+        invalidate_all()
+        with expr.folding(False):
+            unfolded_outputs, _, _ = materials._graph_for(features, records)
+            unfolded = flat_node_count(tuple(unfolded_outputs.values()))
+        invalidate_all()
+        per_features[features.label()] = {"group": ng.name, "blender_nodes_flat": flat_tree_node_count(ng),
+                                          "groups_nested": len(counts), "largest_group": max(counts.values()),
+                                          "ir_ops_unfolded": unfolded, "ir_ops_folded": folded}
+    # all features on, for reference (not used by the demo)
+    everything = Features("kulla_conty", "wrapped", sheen=True, cloth=True)
+    outputs, _, _ = materials._graph_for(everything, records)
+    folded = flat_node_count(tuple(outputs.values()))
+    invalidate_all()
+    with expr.folding(False):
+        unfolded = flat_node_count(tuple(materials._graph_for(everything, records)[0].values()))
+    invalidate_all()
+    per_features.setdefault(everything.label() + " (all on, not in the demo)",
+                            {"ir_ops_unfolded": unfolded, "ir_ops_folded": folded})
+    return {"groups": dict(sorted(groups.items())), "materials": per_features,
+            "materials_using": {k: v.label() for k, v in scene_materials.items()}}
+
+
+def run(out_dir, lut_dir=None, resolution=256, repeats=3, eevee=True, log=print):
+    import bpy
+
+    import build_demo_scene
+    from engine_parity import compare, eevee_available, render_engines
+    from rt_lookdev.core.lut import lookup
+    import _png
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    result = {"resolution": resolution}
+    with lookup.use_lut_dir(lut_dir):
+        t0 = time.perf_counter()
+        spheres = build_demo_scene.build_demo_scene(lut_dir, resolution)
+        result["build_seconds"] = round(time.perf_counter() - t0, 3)
+        blend = out_dir / "lookdev_demo.blend"
+        bpy.ops.wm.save_as_mainfile(filepath=str(blend.resolve()))
+        result["blend"] = str(blend)
+        log(f"      demo scene: {len(spheres)} spheres, built in {result['build_seconds']} s, saved to {blend}")
+        result["node_counts"] = node_counts(spheres)
+    scene = bpy.context.scene
+    size = (scene.render.resolution_x, scene.render.resolution_y)
+    cycles_times = []
+    for _ in range(repeats):
+        renders = render_engines(scene, engines=("CYCLES",), resolution=size, path=out_dir)
+        cycles_times.append(renders["CYCLES"][1])
+    cycles = renders["CYCLES"][0]
+    result["cycles"] = {"seconds_median": statistics.median(cycles_times), "seconds": cycles_times,
+                        "samples": 1, "size": list(size), "finite": bool(np.isfinite(cycles).all()),
+                        "max": float(cycles.max()), "min": float(cycles.min())}
+    log(f"      Cycles {size[0]}x{size[1]}, 1 sample: median {result['cycles']['seconds_median']:.3f} s "
+        f"of {repeats}")
+    _png.write_rgb(out_dir / "cycles.png", _tonemap(cycles))
+    result["passed"] = result["cycles"]["finite"]
+    if eevee:
+        ok, why = eevee_available()
+        result["eevee_available"] = why
+        if ok:
+            times = []
+            for _ in range(2):
+                r = render_engines(scene, engines=("BLENDER_EEVEE",), resolution=size, path=out_dir)
+                times.append(r["BLENDER_EEVEE"][1])
+            ev = r["BLENDER_EEVEE"][0]
+            stats = compare(cycles, ev, positive_floor=POSITIVE_FLOOR)
+            c, e = cycles.astype(np.float64), ev.astype(np.float64)
+            big = c > POSITIVE_FLOOR
+            rel = np.abs(e[big] - c[big]) / c[big]
+            stats["p999"] = float(np.percentile(rel, 99.9))
+            stats["fraction_over_1e-2"] = float((rel > 1e-2).mean())
+            result["eevee"] = {"seconds_first": times[0], "seconds_second": times[1], "stats": stats,
+                               "renderer": why}
+            err = np.zeros(c.shape[:2])
+            err_full = np.where(big, np.abs(e - c) / np.maximum(c, POSITIVE_FLOOR), 0.0)
+            err = err_full.max(axis=-1)
+            _png.write_rgb(out_dir / "eevee.png", _tonemap(ev))
+            _png.heatmap(out_dir / "eevee_vs_cycles_rel.png", err, 1e-2, scale=2)
+            result["eevee"]["passed"] = stats["p999"] <= EEVEE_P999_TOL and stats["max"] <= EEVEE_MAX_TOL
+            result["passed"] = result["passed"] and result["eevee"]["passed"]
+            log(f"      EEVEE: {times[0]:.1f} s first, {times[1]:.1f} s second; rel. error vs Cycles where > "
+                f"{POSITIVE_FLOOR}: median {stats['median']:.2e}, p99 {stats['p99']:.2e}, p99.9 {stats['p999']:.2e}, "
+                f"max {stats['max']:.2e}")
+        else:
+            log(f"      EEVEE not available: {why}")
+    (out_dir / "demo.json").write_text(json.dumps(result, indent=2, default=float))
+    (out_dir / "demo.md").write_text(format_markdown(result))
+    return result
+
+
+def format_markdown(result):
+    nc = result["node_counts"]
+    lines = [f"Demo scene `{result['blend']}`: {result['cycles']['size'][0]}x{result['cycles']['size'][1]} px.", "",
+             "| RT Lit material (features) | IR ops before folding | after | Blender nodes, flattened | "
+             "nested groups | largest group |", "|---|---|---|---|---|---|"]
+    for label, m in nc["materials"].items():
+        lines.append(f"| {label} | {m['ir_ops_unfolded']} | {m['ir_ops_folded']} | {m.get('blender_nodes_flat', '-')} | "
+                     f"{m.get('groups_nested', '-')} | {m.get('largest_group', '-')} |")
+    lines += ["", "Nodes per group:", "", "| group | nodes |", "|---|---|"]
+    lines += [f"| {name} | {count} |" for name, count in nc["groups"].items()]
+    c = result["cycles"]
+    lines += ["", f"Cycles, 1 sample: median **{c['seconds_median']:.3f} s** of {len(c['seconds'])} renders "
+                  f"({', '.join(f'{t:.3f}' for t in c['seconds'])} s); all pixels finite: {c['finite']}.", ""]
+    ev = result.get("eevee")
+    if ev:
+        s = ev["stats"]
+        lines += [f"EEVEE ({ev['renderer']}), 1 sample: {ev['seconds_first']:.1f} s first render, "
+                  f"{ev['seconds_second']:.1f} s second.", "",
+                  f"EEVEE vs Cycles, relative error where Cycles > {POSITIVE_FLOOR} ({s['count']} values): "
+                  f"median {s['median']:.2e}, p99 {s['p99']:.2e}, p99.9 {s['p999']:.2e}, max {s['max']:.2e}; "
+                  f"{100 * s['fraction_over_1e-2']:.3f}% of values over 1e-2 "
+                  f"(acceptance p99.9 <= {EEVEE_P999_TOL}, max <= {EEVEE_MAX_TOL}): "
+                  f"**{'PASS' if ev['passed'] else 'FAIL'}**", ""]
+    else:
+        lines += [f"EEVEE: not run ({result.get('eevee_available', 'skipped')}).", ""]
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--out", type=Path, default=REPO / "out" / "report" / "demo")
+    p.add_argument("--lut-dir", type=Path, default=None)
+    p.add_argument("--resolution", type=int, default=256)
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--skip-eevee", action="store_true")
+    args = p.parse_args(argv)
+    result = run(args.out, args.lut_dir, args.resolution, args.repeats, not args.skip_eevee)
+    print((args.out / "demo.md").read_text())
+    return 0 if result["passed"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
