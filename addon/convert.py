@@ -1,7 +1,8 @@
 """Convert a Principled BSDF material into an RT Lit lookdev material and back.
 
-An RT Lit material's surface is ``RT Lit group node -> Emission (strength 1) -> Material
-Output``: the group computes the outgoing radiance itself.  The group's inputs
+An RT Lit material's surface is ``RT Lit group node (Shader output) -> Material Output``: the
+group computes the outgoing radiance itself and emits it (one Emission closure per light inside
+the group; older materials with an Emission node in between are still recognised).  The group's inputs
 (``RT_LIT_INPUTS``) take the Principled BSDF's names where one exists, so the conversion maps
 them one to one (``MAPPED_INPUTS``): a linked input is re-linked from the same source socket, an
 unlinked one gets the value copied (the value is copied under a link too, so it is there when
@@ -47,7 +48,7 @@ RT_LIT_NODE_NAME = "RT Lit"
 EMISSION_NODE_NAME = "RT Lit Emission"
 FRAME_NODE_NAME = "RT Lit Kept Principled"
 FRAME_LABEL = "Original Principled (kept for conversion back)"
-RT_LIT_OUTPUT = "Radiance"
+RT_LIT_OUTPUT = "Shader"
 
 #: Custom properties.  On the material:
 FEATURES_PROP = "rtl_features"          # dict of Features: the material's switches
@@ -405,14 +406,6 @@ def principled_to_rt_lit(material, group_factory, features=None):
     rt.width = max(rt.width, 240.0)
     rt.location = (px - 180.0, py)
 
-    emission = tree.nodes.new("ShaderNodeEmission")
-    emission.name = EMISSION_NODE_NAME
-    emission.label = "RT Lit Radiance"
-    emission[ROLE_PROP] = "emission"
-    emission.inputs["Strength"].default_value = 1.0
-    emission.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    emission.location = (px - 180.0 + rt.width + 40.0, py)
-
     _transfer(tree, principled, rt, MAPPED_INPUTS)
     remembered = material.get(RT_ONLY_VALUES_PROP)
     if remembered is not None:
@@ -426,8 +419,8 @@ def principled_to_rt_lit(material, group_factory, features=None):
                     pass
         del material[RT_ONLY_VALUES_PROP]
 
-    tree.links.new(rt.outputs[RT_LIT_OUTPUT], emission.inputs["Color"])
-    tree.links.new(emission.outputs["Emission"], output.inputs["Surface"])  # replaces the BSDF link
+    # the group's Shader output is the emission of every light (one closure per light)
+    tree.links.new(rt.outputs[RT_LIT_OUTPUT], output.inputs["Surface"])  # replaces the BSDF link
 
     # Keep the Principled node, collapsed in a labelled frame below the RT Lit node.
     frame = tree.nodes.new("NodeFrame")

@@ -138,8 +138,13 @@ def _graph_for(features, records):
             params[param] = g.input(f"Light {index} {param}")
             light_inputs.append(f"Light {index} {param}")
         lights_in.append((kind, params))
-    radiance = rt_lit.rt_lit_radiance(features, material, geometry, lights_in)
-    return {"Radiance": radiance}, list(RT_LIT_INPUTS), light_inputs
+    parts = rt_lit.rt_lit_radiance_parts(features, material, geometry, lights_in)
+    outputs = {"Radiance": parts[0]}
+    for i, part in enumerate(parts):
+        outputs["Material Emission" if i == 0 else f"Light {i - 1} Radiance"] = part
+        if i:
+            outputs["Radiance"] = outputs["Radiance"] + part
+    return outputs, list(RT_LIT_INPUTS), light_inputs
 
 
 def rt_lit_group_name(features):
@@ -158,6 +163,7 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None):
         name, kind = entry.rsplit(":", 1)
         records.append((name, kind))
     outputs, material_names, light_names = _graph_for(features, records)
+    shader_sums = {"Shader": [n for n in outputs if n != "Radiance"]}
     cache = {}
 
     def geometry_socket(output):
@@ -186,6 +192,7 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None):
     sockets = (RT_LIT_INPUTS, RT_LIT_OUTPUTS)
     ng, _ = node_emit.ensure_tree(rt_lit_group_name(features), outputs, material_names, sockets,
                                   internal_inputs=internal, stamp_extra=repr(records), lut_dir=lut_dir,
+                                  shader_sums=shader_sums,
                                   description=f"RT Lit lookdev material ({features.label()}): outgoing "
                                               "radiance from every scene light, for an Emission shader")
     ng[FEATURES_KEY] = features.as_dict()
@@ -203,7 +210,7 @@ def rebuild_rt_lit_groups(scene, lut_dir=None):
 
 
 def assign_rt_lit(material, features=None, scene=None, lut_dir=None):
-    """Make ``material`` an RT Lit material: RT Lit group -> Emission -> Material Output."""
+    """Make ``material`` an RT Lit material: RT Lit group (Shader) -> Material Output."""
     ng = ensure_rt_lit_group(features, scene, lut_dir)
     nt = material.node_tree
     nodes = nt.nodes
@@ -212,16 +219,11 @@ def assign_rt_lit(material, features=None, scene=None, lut_dir=None):
         group = nodes.new("ShaderNodeGroup")
         group.name = group.label = "RT Lit"
     group.node_tree = ng
-    emission = nodes.get("RT Lit Emission") or nodes.new("ShaderNodeEmission")
-    emission.name = "RT Lit Emission"
-    emission.inputs["Strength"].default_value = 1.0
     output = next((n for n in nodes if n.bl_idname == "ShaderNodeOutputMaterial" and n.is_active_output), None)
     if output is None:
         output = nodes.new("ShaderNodeOutputMaterial")
-    group.location = (output.location.x - 500.0, output.location.y)
-    emission.location = (output.location.x - 200.0, output.location.y)
-    nt.links.new(group.outputs["Radiance"], emission.inputs["Color"])
-    nt.links.new(emission.outputs["Emission"], output.inputs["Surface"])
+    group.location = (output.location.x - 300.0, output.location.y)
+    nt.links.new(group.outputs["Shader"], output.inputs["Surface"])
     material[FEATURES_KEY] = (features or Features()).as_dict()
     return group
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from collections import Counter
 
+import numpy as np
+
 import bpy
 
 from ..core.ir.expr import FLOAT, VECTOR, Expr
@@ -84,13 +86,14 @@ def _depths(order):
 
 
 #: Bump when the emitter's output for an unchanged IR changes (layout aside): stamps include it.
-EMITTER_VERSION = 2
+EMITTER_VERSION = 4
 
 #: Soft cap on nodes per emitted tree (../shared/reference/blender_addon.md §2.3: flat trees build
 #: super-linearly; nested groups of <= ~150 nodes build ~50x faster with identical pixels).
 MAX_GROUP_NODES = 150
 
 _SOCKET_TYPES = {"float": "NodeSocketFloat", "vector": "NodeSocketVector", "color": "NodeSocketColor",
+                 "shader": "NodeSocketShader",
                  FLOAT: "NodeSocketFloat", VECTOR: "NodeSocketVector"}
 
 
@@ -120,6 +123,8 @@ def _new_interface_socket(iface, name, in_out, kind, spec, panels):
 def _apply_socket_spec(item, in_out, spec):
     socket_kind = spec.kind
     item.description = spec.description
+    if socket_kind == "shader":
+        return item
     if spec.subtype and spec.subtype != "NONE":
         item.subtype = spec.subtype
     if in_out == "INPUT":
@@ -201,12 +206,16 @@ class _Emitter:
                 self.function_group(node.graph.functions[node.attr("function")])
 
     # -- one tree ----------------------------------------------------------------------------
-    def fill(self, ng, outputs, input_names, sockets=None, kinds=None, internal_inputs=None, description=""):
+    def fill(self, ng, outputs, input_names, sockets=None, kinds=None, internal_inputs=None, description="",
+             shader_sums=None):
         """Emit ``outputs`` (name -> Expr of one graph) into the empty tree ``ng``.
 
         ``input_names``: interface inputs, in order; ``sockets``: (inputs, outputs), each
         name -> interface.Socket; ``internal_inputs``: graph input name -> callable(nodes, links) giving
         an output socket inside the tree (e.g. Geometry > Position) instead of an interface input.
+        ``shader_sums``: shader output name -> names of colour outputs; each becomes an Emission
+        closure (strength 1) and they are summed with Add Shader nodes; those colour outputs are
+        not interface sockets.
         """
         in_sockets, out_sockets = sockets or ({}, {})
         kinds, internal_inputs = kinds or {}, internal_inputs or {}
@@ -222,7 +231,11 @@ class _Emitter:
             raise ValueError(f"inputs lack graph inputs {sorted(missing)}")
 
         ng.description = description
-        wanted = [(out_name, "OUTPUT", expr.kind, out_sockets.get(out_name)) for out_name, expr in outs]
+        shader_sums = shader_sums or {}
+        hidden = {n for names in shader_sums.values() for n in names}
+        wanted = [(name, "OUTPUT", "shader", out_sockets.get(name)) for name in shader_sums]
+        wanted += [(out_name, "OUTPUT", expr.kind, out_sockets.get(out_name)) for out_name, expr in outs
+                   if out_name not in hidden]
         wanted += [(n, "INPUT", inputs[n].kind if n in inputs else kinds.get(n, FLOAT), in_sockets.get(n))
                    for n in input_names]
         items = _ensure_interface(ng, wanted)
@@ -275,13 +288,29 @@ class _Emitter:
                 produced[node.id] = bn.outputs[0]
             elif op in MIX_SOCKETS:
                 fac, a_id, b_id, res = MIX_SOCKETS[op]
-                bn = nodes.new("ShaderNodeMix")
-                bn.data_type = "FLOAT" if op == "select" else "VECTOR"
-                if op == "vselect":
-                    bn.factor_mode = "UNIFORM"
                 cond, if_true, if_false = node.args
-                feed(_socket(bn.inputs, fac), cond)
-                feed(_socket(bn.inputs, a_id), if_false)
+
+                def mix_node():
+                    m = nodes.new("ShaderNodeMix")
+                    m.data_type = "FLOAT" if op == "select" else "VECTOR"
+                    if op == "vselect":
+                        m.factor_mode = "UNIFORM"
+                    feed(_socket(m.inputs, fac), cond)
+                    return m
+
+                # EEVEE's mix(a, b, 1) is a + (b - a): b rounded to ulp(a), wrong when |a| >> |b|
+                # (measured; Cycles is exact).  mix(mix(a, 0, c), b, c) is exact for c in {0, 1}
+                # in both engines; a constant-zero false branch needs only the second node.
+                false_is_zero = if_false.is_const and not np.any(if_false.attr("value"))
+                bn = mix_node()
+                if false_is_zero:
+                    feed(_socket(bn.inputs, a_id), if_false)
+                else:
+                    zero = mix_node()
+                    feed(_socket(zero.inputs, a_id), if_false)
+                    _socket(zero.inputs, b_id).default_value = 0.0 if op == "select" else (0.0, 0.0, 0.0)
+                    place(zero, col, f"{op} (zero)")
+                    links.new(_socket(zero.outputs, res), _socket(bn.inputs, a_id))
                 feed(_socket(bn.inputs, b_id), if_true)
                 produced[node.id] = _socket(bn.outputs, res)
             elif op == "combine":
@@ -347,7 +376,31 @@ class _Emitter:
 
         group_out = nodes.new("NodeGroupOutput")
         place(group_out, max_depth + 1, "outputs")
+        for row, (shader_name, parts) in enumerate(shader_sums.items()):
+            total = None
+            for i, part in enumerate(parts):
+                expr = outputs[part]
+                if expr.is_const and not any(expr.attr("value")):
+                    continue                      # a closure of zero emission adds nothing
+                emission = nodes.new("ShaderNodeEmission")
+                emission.label = part
+                emission.location = ((max_depth + 1) * COLUMN_WIDTH, -(row + i) * ROW_HEIGHT)
+                emission.inputs["Strength"].default_value = 1.0
+                feed(emission.inputs["Color"], expr)
+                if total is None:
+                    total = emission.outputs[0]
+                    continue
+                add = nodes.new("ShaderNodeAddShader")
+                add.location = ((max_depth + 2) * COLUMN_WIDTH, -(row + i) * ROW_HEIGHT)
+                links.new(total, add.inputs[0])
+                links.new(emission.outputs[0], add.inputs[1])
+                total = add.outputs[0]
+            if total is not None:
+                links.new(total, _socket(group_out.inputs, items[(shader_name, "OUTPUT")].identifier))
+        group_out.location = ((max_depth + 3) * COLUMN_WIDTH, 0.0)
         for out_name, expr in outs:
+            if out_name in hidden:
+                continue
             item = items[(out_name, "OUTPUT")]
             sock = _socket(group_out.inputs, item.identifier)
             if expr.is_const:
@@ -387,13 +440,13 @@ def ensure_function_group(function, lut_dir=None):
 
 
 def ensure_tree(name, outputs, input_names, sockets=None, internal_inputs=None, stamp_extra="",
-                lut_dir=None, description=""):
+                lut_dir=None, description="", shader_sums=None):
     """A named group computing ``outputs`` with some inputs produced inside the tree
     (``internal_inputs``); rebuilt only when the graph's structure or ``stamp_extra`` changes."""
     from ..core.ir.expr import Function
 
     fn = Function(name, {n: FLOAT for n in []}, outputs)
-    stamp = f"{EMITTER_VERSION}:{fn.key}:{sorted(input_names)}:{stamp_extra}"
+    stamp = f"{EMITTER_VERSION}:{fn.key}:{sorted(input_names)}:{stamp_extra}:{shader_sums!r}"
     ng = bpy.data.node_groups.get(name)
     if ng is not None and ng.get("rtl_stamp") == stamp:
         return ng, False
@@ -402,7 +455,7 @@ def ensure_tree(name, outputs, input_names, sockets=None, internal_inputs=None, 
     else:
         ng.nodes.clear()
     _Emitter(lut_dir).fill(ng, outputs, input_names, sockets, internal_inputs=internal_inputs,
-                           description=description)
+                           description=description, shader_sums=shader_sums)
     ng["rtl_stamp"] = stamp
     return ng, True
 

@@ -77,6 +77,11 @@ class RTL_OT_lut_status(bpy.types.Operator):
         return {'FINISHED'}
 
 
+#: Area lights an RT Lit material can shade in Cycles with typical switches (measured:
+#: scripts/benchmark_rt_lit.py; 8 for Kulla-Conty, 3 with every technique on).
+CYCLES_LIGHT_BUDGET = 8
+
+
 class RTL_OT_sync_lights(bpy.types.Operator):
     """Rebuild the RT Lit groups for the lights now in the scene (after adding, removing or
     changing the shape of a light; moving or editing a light needs no sync: drivers follow it)"""
@@ -103,8 +108,56 @@ class RTL_OT_sync_lights(bpy.types.Operator):
             self.report({'ERROR'}, f"Could not sync lights: {ex}")
             return {'CANCELLED'}
         kinds = ", ".join(f"{obj.name} ({kind})" for obj, kind in records) or "none"
-        self.report({'INFO'}, f"RT Lit: {len(records)} lights [{kinds}]; {len(groups)} RT Lit groups rebuilt")
+        message = f"RT Lit: {len(records)} lights [{kinds}]; {len(groups)} RT Lit groups rebuilt"
+        if len(records) > CYCLES_LIGHT_BUDGET:
+            # Cycles' SVM stack (255 floats per material) limits the lights one material can shade
+            self.report({'WARNING'}, f"{message}. Cycles may fail to compile RT Lit materials with more than "
+                                     f"{CYCLES_LIGHT_BUDGET} lights (3 with every technique on; "
+                                     "docs/benchmarks/rt_lit.md); EEVEE has no such limit")
+        else:
+            self.report({'INFO'}, message)
         return {'FINISHED'}
 
 
-classes = (RTL_OT_lut_status, RTL_OT_sync_lights)
+class RTL_OT_add_node_groups(bpy.types.Operator):
+    """Load every RT Lookdev node group into this file (they then appear in Add > Group);
+    groups already present and current are reused, stale ones are rebuilt in place"""
+
+    bl_idname = "rtl.add_node_groups"
+    bl_label = "Add RT Lookdev Node Groups"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        lut_dir = preferences.lut_directory(context)
+        if not lut_dir.is_dir():
+            cls.poll_message_set(f"LUT directory does not exist: {lut_dir}")
+            return False
+        return True
+
+    def execute(self, context):
+        from ..core.lut import lookup
+        from ..node_groups import catalog
+        from . import node_emit
+
+        lut_dir = preferences.lut_directory(context)
+        wm = context.window_manager
+        functions = catalog.all_functions()
+        before = set(bpy.data.node_groups.keys())
+        try:
+            with lookup.use_lut_dir(lut_dir):
+                wm.progress_begin(0, len(functions))
+                for i, fn in enumerate(functions):
+                    node_emit.ensure_function_group(fn, lut_dir)
+                    wm.progress_update(i + 1)
+        except Exception as ex:
+            self.report({'ERROR'}, f"Could not build the node groups: {ex}")
+            return {'CANCELLED'}
+        finally:
+            wm.progress_end()
+        added = len(set(bpy.data.node_groups.keys()) - before)
+        self.report({'INFO'}, f"RT Lookdev: {len(functions)} node groups available ({added} new)")
+        return {'FINISHED'}
+
+
+classes = (RTL_OT_lut_status, RTL_OT_sync_lights, RTL_OT_add_node_groups)

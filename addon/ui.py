@@ -28,6 +28,7 @@ class RTL_PT_material(bpy.types.Panel):
         else:
             col.operator("rtl.convert_to_rt_lit", icon='SHADING_RENDERED')
         layout.operator("rtl.sync_lights", icon='LIGHT_AREA')
+        layout.operator("rtl.add_node_groups", icon='NODETREE')
         layout.operator("rtl.lut_status", icon='IMAGE_DATA')
 
 

@@ -261,13 +261,17 @@ def lut_bilinear_function(lut):
         v0, v1, fv = axis(v, h)
         g = graph_of(u, v)
         g.luts.setdefault(lut.name, lut.table)
+        # each tap is weighted and accumulated at once (one live tap at a time: Cycles' SVM stack
+        # holds 255 floats for a whole material, and a tap read by four later mixes stays live)
+        taps = ((u0, v0, (1.0 - fu) * (1.0 - fv)), (u1, v0, fu * (1.0 - fv)),
+                (u0, v1, (1.0 - fu) * fv), (u1, v1, fu * fv))
         out = {}
         for c, name in enumerate("RGBA"):
-            def tap(uu, vv):
-                return g.make("texel", (uu, vv), (("table", lut.name), ("channel", c)))
-            bottom = mix(tap(u0, v0), tap(u1, v0), fu)
-            top = mix(tap(u0, v1), tap(u1, v1), fu)
-            out[name] = mix(bottom, top, fv)
+            total = None
+            for uu, vv, weight in taps:
+                term = g.make("texel", (uu, vv), (("table", lut.name), ("channel", c))) * weight
+                total = term if total is None else total + term
+            out[name] = total
         return out
 
     coord = Socket("float", 0.5, description="Texture coordinate (texel centres at (i + 0.5)/N)")

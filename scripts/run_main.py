@@ -11,8 +11,10 @@ Steps (each prints what it does):
 3. LTC area lights (numpy): end-to-end error of the LTC tables on seeded random quads and
    disks against brute-force integrals (a smaller set than scripts/benchmark_ltc.py).
 4. Cycles render check: spheres under a white world (scripts/validate_energy.py).
-5. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
-Later issues add the demo lookdev scene and the node-group validations here.
+5. Demo lookdev scene (scripts/build_demo_scene.py, scripts/demo_report.py): RT Lit spheres under a
+   quad and a disk light, saved to <out>/demo/lookdev_demo.blend; node counts, Cycles render time,
+   one EEVEE render compared with Cycles.
+6. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
 """
 from __future__ import annotations
 
@@ -47,7 +49,7 @@ def _progress(group, done, total):
 
 
 def step_luts(lut_dir):
-    print(f"[1/5] LUTs in {lut_dir}", flush=True)
+    print(f"[1/6] LUTs in {lut_dir}", flush=True)
     records = bake.bake(lut_dir, progress=_progress, log=lambda line: print("      " + line, flush=True))
     status = catalog.lut_status(lut_dir)
     return {"records": [{"group": r.group, "state": r.state, "seconds": round(r.seconds, 2)} for r in records],
@@ -56,7 +58,7 @@ def step_luts(lut_dir):
 
 
 def step_numpy_checks(lut_dir):
-    print("[2/5] numpy energy checks", flush=True)
+    print("[2/6] numpy energy checks", flush=True)
     t0 = time.perf_counter()
     tables = lookup.EnergyTables(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -86,8 +88,18 @@ def step_numpy_checks(lut_dir):
     return out
 
 
+def step_demo(out_dir, lut_dir, eevee=True):
+    print("[5/6] demo lookdev scene: build, node counts, Cycles and EEVEE renders", flush=True)
+    import demo_report
+
+    result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee,
+                             log=lambda line: print(line, flush=True))
+    result["summary_markdown"] = demo_report.format_markdown(result)
+    return result
+
+
 def step_render(out_dir, lut_dir, resolution, samples):
-    print("[4/5] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
+    print("[4/6] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
     import validate_energy  # imports bpy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -98,7 +110,7 @@ def step_render(out_dir, lut_dir, resolution, samples):
 
 
 def step_ltc(lut_dir):
-    print("[3/5] LTC area lights: random quads and disks vs brute force", flush=True)
+    print("[3/6] LTC area lights: random quads and disks vs brute force", flush=True)
     import benchmark_ltc
 
     t0 = time.perf_counter()
@@ -157,6 +169,9 @@ def write_report(report, out_dir):
                   f"{settings['seeds']}; per-bin acceptance |bias| <= {settings['z_max']} SE + {settings['sys_tol']} "
                   f"(GGX vs our E), Multiscatter GGX 1 +- {settings['ms_tol']}. Full numbers in "
                   f"energy_render/energy_validation.json.", "", render["summary_markdown"], ""]
+    demo = report.get("demo")
+    lines += ["## Demo lookdev scene (RT Lit materials)", ""]
+    lines += [demo["summary_markdown"], ""] if demo else ["Skipped (--skip-render).", ""]
     lines += [f"Overall: **{'PASS' if report['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
@@ -165,7 +180,8 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", type=Path, default=REPO / "out" / "report")
     p.add_argument("--lut-dir", type=Path, default=catalog.default_lut_dir())
-    p.add_argument("--skip-render", action="store_true", help="skip the Cycles render check")
+    p.add_argument("--skip-render", action="store_true", help="skip the Cycles render check and the demo scene")
+    p.add_argument("--skip-eevee", action="store_true", help="demo scene: skip the EEVEE render")
     p.add_argument("--render-resolution", type=int, default=None, help="pixels per sphere")
     p.add_argument("--render-samples", type=int, default=None, help="Cycles samples per pixel")
     args = p.parse_args(argv)
@@ -177,13 +193,15 @@ def main(argv=None):
         return 1
     report["numpy_checks"] = step_numpy_checks(args.lut_dir)
     report["ltc"] = step_ltc(args.lut_dir)
-    report["render"] = None
+    report["render"] = report["demo"] = None
     if not args.skip_render:
         report["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples)
+        report["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee)
     report["passed"] = bool(report["luts"]["passed"] and report["numpy_checks"]["passed"] and report["ltc"]["passed"]
-                            and (report["render"] is None or report["render"].get("passed", False)))
+                            and (report["render"] is None or report["render"].get("passed", False))
+                            and (report["demo"] is None or report["demo"].get("passed", False)))
     report["seconds"] = time.perf_counter() - t0
-    print("[5/5] report", flush=True)
+    print("[6/6] report", flush=True)
     write_report(report, args.out)
     print((args.out / "report.md").read_text())
     print(f"report written to {args.out / 'report.md'} and report.json")

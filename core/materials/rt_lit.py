@@ -193,11 +193,21 @@ def rt_lit_radiance(features, material, geometry, lights_in_scene):
     ``material``: RT_LIT_INPUTS name -> value; ``geometry``: Position, Geometry Normal, Incoming;
     ``lights_in_scene``: list of (kind, {driver parameter name -> value}).
     """
+    parts = rt_lit_radiance_parts(features, material, geometry, lights_in_scene)
+    total = parts[0]
+    for part in parts[1:]:
+        total = total + part
+    return total
+
+
+def rt_lit_radiance_parts(features, material, geometry, lights_in_scene):
+    """[the material's emission, radiance from light 0, from light 1, ...]: the terms of
+    ``rt_lit_radiance`` (in nodes, one Emission closure each)."""
     from .. import lights
 
     surface = SURFACE(**{k: material[k] for k in RT_LIT_INPUTS},
                       **{k: geometry[k] for k in ("Geometry Normal", "Incoming")})
-    total = surface["Emission"]
+    parts = [surface["Emission"]]
     for kind, params in lights_in_scene:
         data_fn = lights.LIGHT_DATA[kind]
         args = dict(params)
@@ -206,8 +216,8 @@ def rt_lit_radiance(features, material, geometry, lights_in_scene):
         light = data_fn(**args)
         fn = shade_function(kind, features)
         available = dict(surface, Position=geometry["Position"], **light)
-        total = total + fn(**_lobe_args(fn, available))["Radiance"]
-    return total
+        parts.append(fn(**_lobe_args(fn, available))["Radiance"])
+    return parts
 
 
 __all__ = ["SURFACE", "rt_lit_radiance", "shade_function", "combine_lobes", "Features", "RT_LIT_OUTPUTS",

@@ -37,8 +37,13 @@ RT_LIT_INPUTS = {
                      hide_value=True),
 }
 
-#: Output name -> socket.
+#: Output name -> socket.  "Shader" is the material's surface: one Emission closure per light (and
+#: one for the material's own emission), summed by Add Shader nodes.  Cycles compiles each closure's
+#: nodes in turn, so per-light values do not pile up on its SVM stack (255 floats per material: a
+#: single summed colour overflowed it from 2 to 8 lights, measured).  "Radiance" is the same total
+#: as a colour, for use in other node setups.
 RT_LIT_OUTPUTS = {
+    "Shader": Socket("shader", None, description="Outgoing radiance as emission: connect to Surface"),
     "Radiance": Socket("color", (0.0, 0.0, 0.0, 1.0), description="Outgoing radiance towards the camera"),
 }
 

@@ -8,7 +8,8 @@ from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS, RT_LIT_OUT
 
 pytestmark = pytest.mark.blender
 
-SOCKET_TYPES = {"float": "NodeSocketFloat", "color": "NodeSocketColor", "vector": "NodeSocketVector"}
+SOCKET_TYPES = {"float": "NodeSocketFloat", "color": "NodeSocketColor", "vector": "NodeSocketVector",
+                "shader": "NodeSocketShader"}
 
 #: Non-default values for every mapped input but Base Color (linked) and Normal (linked).
 EDITED = {
@@ -64,6 +65,9 @@ class StandInFactory:
         gout = group.nodes.new("NodeGroupOutput")
         gout.location = (300, 0)
         group.links.new(gin.outputs["Base Color"], gout.inputs["Radiance"])
+        emission = group.nodes.new("ShaderNodeEmission")
+        group.links.new(gin.outputs["Base Color"], emission.inputs["Color"])
+        group.links.new(emission.outputs[0], gout.inputs["Shader"])
         return group
 
 
@@ -160,11 +164,9 @@ def test_convert_to_rt_lit_maps_every_input(bpy_module, convert, factory):
     assert factory.calls == [features]
     rt = tree.nodes["RT Lit"]
     assert rt.bl_idname == "ShaderNodeGroup" and rt.node_tree == factory(features)
-    emission = _surface_source(tree)
-    assert emission.bl_idname == "ShaderNodeEmission"
-    assert emission.inputs["Strength"].default_value == 1.0
-    assert emission.inputs["Color"].links[0].from_node == rt
-    assert emission.inputs["Color"].links[0].from_socket.name == "Radiance"
+    surface = tree.nodes["Material Output"].inputs["Surface"].links[0] if "Material Output" in tree.nodes else None
+    assert _surface_source(tree) == rt                      # the group's Shader feeds the output
+    assert surface is None or surface.from_socket.name == "Shader"
 
     # Every mapped value and link lands on the RT Lit node.
     for key, value in EDITED.items():
@@ -405,7 +407,7 @@ def test_principled_in_a_frame_behind_a_reroute(bpy_module, convert, factory):
     location = tuple(getattr(p, "location_absolute", p.location))
 
     convert.principled_to_rt_lit(mat, factory)
-    assert _surface_source(tree).name == "RT Lit Emission"
+    assert _surface_source(tree).name == "RT Lit"
     assert p.parent.name == "RT Lit Kept Principled"
     convert.rt_lit_to_principled(mat)
     assert p.parent == frame and not p.hide

@@ -10,6 +10,9 @@ import pytest
 import build_extension
 from _blender_subprocess import run_snippet
 
+#: bpy.ops.rtl.* of the enabled extension
+OPERATORS = ["add_node_groups", "convert_to_principled", "convert_to_rt_lit", "lut_status", "sync_lights"]
+
 pytestmark = pytest.mark.blender
 
 MODULE = "bl_ext.user_default.rt_lookdev"
@@ -142,8 +145,7 @@ def test_install_enable_run_disable_leaves_nothing_behind(extension_zip, tmp_pat
     assert result["lut_states"] and set(result["lut_states"].values()) == {"ok"}, result["lut_states"]
 
     # Enabled: the operators and preferences are registered under the extension's name.
-    assert result["enabled_state"]["ops_rtl"] == ["convert_to_principled", "convert_to_rt_lit", "lut_status",
-                                                  "sync_lights"]
+    assert result["enabled_state"]["ops_rtl"] == OPERATORS
     assert result["prefs_bl_idname"] == MODULE
     assert result["prefs_class"] == "RTL_AddonPreferences"
     assert result["prefs_lut_directory"] == ""
@@ -158,7 +160,7 @@ def test_install_enable_run_disable_leaves_nothing_behind(extension_zip, tmp_pat
         after = result[key]
         for field, before in result["before"].items():
             assert after[field] == before, f"{key}: {field} differs from before install"
-    assert result["reenabled"] and result["reenabled_ops"] == ["lut_status"]
+    assert result["reenabled"] and result["reenabled_ops"] == OPERATORS
 
 
 def test_operator_poll_and_reports_follow_the_lut_directory_preference(extension_zip, tmp_path):

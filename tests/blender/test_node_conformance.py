@@ -54,9 +54,13 @@ def _check(name, got, ref):
 
 
 def _expected_node_count(outputs):
+    """One node per operation, one Separate XYZ per separated vector, group input and output, and a
+    second Mix per select whose false branch is not the constant 0 (node_emit: exact in EEVEE)."""
     order = topological_order(list(outputs.values()))
     comps = [n for n in order if n.op in ("x", "y", "z")]
-    return node_count(tuple(outputs.values())) - len(comps) + len({n.args[0].id for n in comps}) + 2
+    selects = [n for n in order if n.op in ("select", "vselect")
+               and not (n.args[2].is_const and not np.any(n.args[2].attr("value")))]
+    return node_count(tuple(outputs.values())) - len(comps) + len({n.args[0].id for n in comps}) + 2 + len(selects)
 
 
 @pytest.mark.parametrize("name", sorted(TECHNIQUES))
@@ -109,7 +113,7 @@ def test_group_is_deterministic_and_one_node_per_operation(empty_scene):
         a = build_node_group(f"RTL_a_{name}", {"out": out})
         b = build_node_group(f"RTL_b_{name}", {"out": out})
         assert node_group_stats(a) == node_group_stats(b)
-        assert len(a.nodes) == len(b.nodes) == node_count(out) + 2
+        assert len(a.nodes) == len(b.nodes) == _expected_node_count({"out": out})
         assert [s.name for s in a.interface.items_tree] == [s.name for s in b.interface.items_tree]
         math = [n for n in a.nodes if n.bl_idname == "ShaderNodeMath"]
         assert math and not any(n.use_clamp for n in math)
@@ -144,8 +148,8 @@ def test_every_ir_operation_renders_like_numpy(empty_scene):
     a, b, u, v = g.input("a"), g.input("b"), g.input("u", "vector"), g.input("v", "vector")
     binary = ("add", "subtract", "multiply", "divide", "power", "minimum", "maximum", "less_than", "greater_than",
               "arctan2")
-    unary = ("sqrt", "inverse_sqrt", "exponent", "log2", "absolute", "arccosine", "arcsine", "sine", "cosine",
-             "tangent")
+    unary = ("sqrt", "inverse_sqrt", "exponent", "log2", "absolute", "floor", "arccosine", "arcsine", "sine",
+             "cosine", "tangent")
     outputs = {op: g.make(op, (a, b)) for op in binary}
     outputs.update({op: g.make(op, (a,)) for op in unary})
     cond = g.make("greater_than", (a, b))
@@ -161,7 +165,8 @@ def test_every_ir_operation_renders_like_numpy(empty_scene):
     outputs["const_arg"] = g.make("power", (g.const(2.0), a))          # a constant on a socket
     outputs["vconst_arg"] = g.make("cross", (g.vconst((0.0, 0.0, 1.0)), u))
     covered = {n.op for n in topological_order(list(outputs.values()))}
-    assert covered | {"lut"} == set(OPS), set(OPS) - covered      # "lut": test_lut_lookup_matches
+    # "lut" and "texel" (table fetches): test_lut_lookup_matches
+    assert covered | {"lut", "texel"} == set(OPS), set(OPS) - covered
 
     ng = build_node_group("RTL_all_ops", outputs, input_order=["a", "b", "u", "v"])
     assert len(ng.nodes) == _expected_node_count(outputs)
@@ -197,24 +202,44 @@ def test_power_of_zero_with_negative_exponent(empty_scene):
 
 
 def test_lut_lookup_matches(empty_scene, lut_dir):
-    """Table lookups in nodes: Image Texture (Linear, EXTEND) against core.lut.lookup.sample_bilinear,
-    every channel, coordinates inside and outside the texel-centre range."""
-    from rt_lookdev.addon.node_emit import build_node_group, node_group_stats
+    """Table lookups in nodes, every channel, coordinates inside and outside the texel-centre range:
+    the raw Image Texture ops ("lut": Linear; "texel": Closest) and the bilinear node function that
+    shading code uses (four Closest fetches), all against core.lut.lookup.sample_bilinear."""
+    from rt_lookdev.addon.node_emit import build_node_group, node_group_stats, tree_node_counts
     from rt_lookdev.core import shading_ops as op
     from rt_lookdev.core.ir import trace
     from rt_lookdev.core.lut import catalog, exr_io
+    from rt_lookdev.core.lut.lookup import sample_bilinear
 
-    lut = op.Lut("ltc_ggx_inv", exr_io.read_table(lut_dir / catalog.TABLES["ltc_ggx_inv"].filename)[0])
-    _, outs = trace(lambda u, v: tuple(op.lut_sample(lut, u, v, c) for c in range(4)), {"u": "float", "v": "float"})
-    ng = build_node_group("RTL_lut", {f"c{c}": o for c, o in enumerate(outs)}, input_order=["u", "v"],
-                          lut_dir=lut_dir)
-    assert node_group_stats(ng)["ShaderNodeTexImage"] == 1       # one texture serves all four channels
+    table = exr_io.read_table(lut_dir / catalog.TABLES["ltc_ggx_inv"].filename)[0]
+    lut = op.Lut("ltc_ggx_inv", table)
+
+    def lookups(u, v):
+        g = u.graph
+        g.luts.setdefault(lut.name, table)
+        raw = tuple(g.make(kind, (u, v), (("table", lut.name), ("channel", c)))
+                    for kind in ("lut", "texel") for c in range(4))
+        return raw + tuple(op.lut_sample(lut, u, v, c) for c in range(4))
+
+    _, outs = trace(lookups, {"u": "float", "v": "float"})
+    names = [f"{kind}{c}" for kind in ("linear", "closest", "bilinear") for c in range(4)]
+    ng = build_node_group("RTL_lut", dict(zip(names, outs)), input_order=["u", "v"], lut_dir=lut_dir)
+    assert node_group_stats(ng)["ShaderNodeTexImage"] == 2       # one Linear, one Closest texture
+    inner = [n.node_tree for n in ng.nodes if n.bl_idname == "ShaderNodeGroup"]
+    assert len(inner) == 1 and inner[0].name == "RTL LUT ltc_ggx_inv"
+    assert node_group_stats(inner[0])["ShaderNodeTexImage"] == 4
+    assert all(n.interpolation == "Closest" for n in inner[0].nodes if n.bl_idname == "ShaderNodeTexImage")
+    assert max(tree_node_counts(ng).values()) <= 150
     assert len([i for i in bpy_images() if i.name.startswith("RTL_")]) == 1
     rng = np.random.default_rng(11)
     vals = {n: rng.uniform(-0.05, 1.05, (64, 64)).astype(np.float32) for n in ("u", "v")}
     vals["u"][0, :4] = [0.5 / 64, 63.5 / 64, 0.0, 1.0]            # texel centres and the edges
-    for c, o in enumerate(outs):
-        _check(f"lut channel {c}", render_group_outputs(ng, vals, f"c{c}"), evaluate(o, vals))
+    exact = sample_bilinear(table, vals["u"], vals["v"])
+    for name, o in zip(names, outs):
+        got = render_group_outputs(ng, vals, name)
+        _check(f"lut {name}", got, evaluate(o, vals))
+        if name.startswith("bilinear"):
+            np.testing.assert_allclose(got, exact[..., int(name[-1])], rtol=2e-6, atol=2e-6)
 
 
 def test_lut_driven_kulla_conty_lobe_matches(empty_scene, lut_dir):
@@ -239,7 +264,8 @@ def test_lut_driven_kulla_conty_lobe_matches(empty_scene, lut_dir):
     names = ["mu_o", "mu_i", "r", "f0"]
     _, out = trace(lobe, dict.fromkeys(names, "float"))
     ng = build_node_group("RTL_kc_lut", {"out": out}, input_order=names, lut_dir=lut_dir)
-    assert node_group_stats(ng)["ShaderNodeTexImage"] == 3       # (1-E, mu_o), (1-E, mu_i), (1-E_avg)
+    lut_calls = [n.node_tree.name for n in ng.nodes if n.bl_idname == "ShaderNodeGroup"]
+    assert sorted(lut_calls) == ["RTL LUT ggx_one_minus_E"] * 2 + ["RTL LUT ggx_one_minus_E_avg"]
     rng = np.random.default_rng(11)
     vals = {n: rng.random((64, 64)).astype(np.float32) for n in names}
     vals["r"][0, :6] = [0.0, 1.0, 1 / 63, 0.5, 1e-4, 1 - 1e-4]

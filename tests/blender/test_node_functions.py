@@ -172,3 +172,39 @@ def test_surface_group_matches_numpy(empty_scene, lut_dir):
     vals["IOR"] = rng.uniform(0.5, 3.0, shape)
     vals["Normal"][:8] = 0.0                        # unlinked normal: the geometry's
     check_function(rt_lit.SURFACE, {k: np.asarray(v, np.float32) for k, v in vals.items()}, lut_dir)
+
+
+def test_every_catalog_group_builds_small_and_the_technique_groups_match_numpy(empty_scene, lut_dir):
+    import bpy
+
+    from rt_lookdev.addon.node_emit import MAX_GROUP_NODES, ensure_function_group, tree_node_counts
+    from rt_lookdev.addon.operators import RTL_OT_add_node_groups
+    from rt_lookdev.addon.preferences import classes as pref_classes  # noqa: F401
+    from rt_lookdev.core.lut import lookup
+    from rt_lookdev.node_groups import catalog
+
+    with lookup.use_lut_dir(lut_dir):
+        counts = {}
+        for fn in catalog.all_functions():
+            counts.update(tree_node_counts(ensure_function_group(fn, lut_dir)))
+        assert all(fn.name in bpy.data.node_groups for fn in catalog.all_functions())
+        assert max(counts.values()) <= MAX_GROUP_NODES, max(counts.items(), key=lambda kv: kv[1])
+        assert all(bpy.data.node_groups[fn.name].description for fn in catalog.all_functions())
+        rng = np.random.default_rng(12)
+        shape = (SIZE, SIZE)
+        vals = {"F0": rng.random(shape + (3,)), "E": rng.uniform(0.0, 1.0, shape), "N.V": rng.random(shape),
+                "Roughness": rng.random(shape), "Distance": rng.uniform(0.0, 3.0, shape),
+                "Radius": rng.uniform(-0.5, 3.0, shape), "Cos To Axis": rng.uniform(-1, 1, shape),
+                "Inner Angle": rng.uniform(0, 3, shape), "Outer Angle": rng.uniform(0, 3, shape),
+                "Diameter": rng.uniform(0, 2, shape)}
+        vals["E"].reshape(-1)[:3] = [0.0, 1.0, 1e-3]
+        for fn in catalog.TECHNIQUES:
+            check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, lut_dir)
+    # the operator builds the same set, reusing what exists
+    bpy.utils.register_class(RTL_OT_add_node_groups)
+    try:
+        before = len(bpy.data.node_groups)
+        assert bpy.ops.rtl.add_node_groups() == {"FINISHED"}
+        assert len(bpy.data.node_groups) == before
+    finally:
+        bpy.utils.unregister_class(RTL_OT_add_node_groups)
