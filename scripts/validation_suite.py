@@ -1,0 +1,698 @@
+"""The cases of scripts/validate.py: scenes, the three images per case, and their metrics.
+
+A case is a grid of unit spheres (one per *variant*: a technique with its material values) under a
+set of Blender lights, seen by an orthographic camera looking along +Y.  Per case:
+
+(a) node render: every sphere gets the RT Lit material (emission only) and Cycles renders 1 sample
+    at pixel centres with Position and Normal passes (``engine_parity.render_cycles_passes``);
+(b) numpy: ``core.materials.rt_lit.rt_lit_radiance`` at (a)'s Position / Normal passes with the
+    material values and the lights' driver values (``numpy_radiance``);
+(c) ground truth, per variant:
+    - ``cycles``: the spheres' materials are swapped to the Cycles closure with the same BRDF
+      (Diffuse BSDF for Lambert, Glossy BSDF GGX for single-scattering GGX with F = 1, Glossy
+      Multiscatter GGX for the multiscattering specular with F = 1, Metallic BSDF GGX with F82 and a
+      white edge tint (= Schlick with F0 = Base Color) for coloured specular, plus a Diffuse BSDF for
+      dielectrics), the same light objects (radius 0 / angle 0 for punctual lights), direct light only
+      (max bounces 0), fixed seed, no adaptive sampling, no denoising, rendered with two seeds;
+    - ``brute``: the integral over the light of the *true* BRDF of the RT Lit material, per pixel, on
+      a seeded subset of the sphere's pixels (``brute_force_radiance``).  The true BRDF is the
+      material's punctual shading (``rt_lit.shade_function("sun", features)``: the lobes evaluated at
+      one light direction, exactly the technique's BRDF times the cosine) summed over a Gauss-Legendre
+      rule on the light (core/ltc/reference.py ``polygon_rule`` / ``disk_rule``), the light clipped at
+      the shading point's horizon where the BRDF vanishes below it (so the rule converges
+      spectrally); the wrapped diffuse extends below the horizon and is integrated unclipped.
+
+Spheres are seen by camera rays only (no sphere shadows or lights another), so a sphere is convex
+and unoccluded; their meshes are 192 x 96 UV spheres with exactly radial normals
+(validate_energy's mesh).  The RT Lit material's specular is switched off for pure-diffuse variants
+by Cloth Weight 1 with a black Cloth Color (RT Lit has no "no specular" switch; spec x (1 - w) +
+cloth x w = 0), and its diffuse by Metallic 1 (albedo 0).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import _bootstrap  # noqa: F401
+
+from rt_lookdev.core.materials.rt_lit_interface import Features
+
+# --- case description -----------------------------------------------------------------------
+
+WHITE = (1.0, 1.0, 1.0)
+BLACK = (0.0, 0.0, 0.0)
+
+#: Technique -> (RT Lit features, truth kind, short description).
+TECHNIQUES = {
+    "lambert": (Features("single", "lambert", cloth=True), "cycles", "Lambert diffuse vs Cycles Diffuse BSDF"),
+    "ggx": (Features("single", "lambert"), "cycles", "single-scattering GGX, F0 = 1, vs Cycles Glossy GGX"),
+    "turquin": (Features("turquin", "lambert"), "cycles",
+                "Turquin multiscattering GGX, F0 = 1, vs Cycles Glossy Multiscatter GGX"),
+    "fdez_aguera": (Features("fdez_aguera", "lambert"), "cycles",
+                    "Fdez-Aguera (talk's area form) GGX, F0 = 1, vs Cycles Glossy Multiscatter GGX"),
+    "dielectric": (Features("single", "lambert"), "cycles",
+                   "GGX (Schlick F0 0.04) + Lambert vs Cycles Metallic BSDF (GGX, F82 white) + Diffuse BSDF"),
+    "metal": (Features("single", "lambert"), "cycles",
+              "GGX with coloured Schlick F0 vs Cycles Metallic BSDF (GGX, F82 white tint)"),
+    "cod": (Features("single", "cod", cloth=True), "brute", "CoD WWII multiscattering diffuse vs its integral"),
+    "wrapped": (Features("single", "wrapped", cloth=True), "brute", "wrapped diffuse vs its integral"),
+    "cloth": (Features("single", "lambert", cloth=True), "brute", "Ashikhmin cloth vs its integral"),
+    "sheen": (Features("single", "lambert", sheen=True, cloth=True), "brute", "Disney sheen vs its integral"),
+    "kulla_conty": (Features("kulla_conty", "lambert"), "brute",
+                    "Kulla-Conty GGX with coloured F0 vs the integral of f_ss + F_ms f_ms"),
+    "turquin_color": (Features("turquin", "lambert"), "brute",
+                      "Turquin GGX with coloured F0 vs the integral of its BRDF f_ss (1 + F0 (1 - E)/E)"),
+}
+
+
+def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
+    """RT Lit input values of a variant (the inputs not given keep RT_LIT_INPUTS' defaults)."""
+    m = {"Roughness": float(roughness), "Base Color": WHITE, "Metallic": 0.0, "Cloth Weight": 0.0,
+         "Cloth Color": BLACK, "Sheen Weight": 0.0, "Wrap": 0.0}
+    if technique in ("lambert", "cod", "wrapped"):
+        m.update({"Base Color": color or WHITE, "Cloth Weight": 1.0, "Cloth Color": BLACK})
+        if technique == "wrapped":
+            m["Wrap"] = float(wrap)
+    elif technique in ("ggx", "turquin", "fdez_aguera"):
+        m.update({"Metallic": 1.0, "Base Color": WHITE})
+    elif technique in ("metal", "kulla_conty", "turquin_color"):
+        m.update({"Metallic": 1.0, "Base Color": color or (0.95, 0.64, 0.54)})
+    elif technique == "dielectric":
+        m.update({"Base Color": color or (0.5, 0.25, 0.1), "IOR": 1.5, "Specular IOR Level": 0.5})
+    elif technique == "cloth":
+        m.update({"Metallic": 1.0, "Cloth Weight": 1.0, "Cloth Color": color or WHITE})
+    elif technique == "sheen":
+        m.update({"Metallic": 1.0, "Cloth Weight": 1.0, "Cloth Color": BLACK, "Sheen Weight": 1.0,
+                  "Sheen Tint": color or WHITE})
+    else:
+        raise ValueError(f"unknown technique {technique!r}")
+    return m
+
+
+@dataclass
+class Variant:
+    technique: str
+    roughness: float = 0.5
+    color: tuple | None = None
+    wrap: float = 0.5
+
+    @property
+    def features(self):
+        return TECHNIQUES[self.technique][0]
+
+    @property
+    def truth(self):
+        return TECHNIQUES[self.technique][1]
+
+    @property
+    def label(self):
+        s = f"{self.technique} r={self.roughness:g}"
+        if self.technique == "wrapped":
+            s += f" w={self.wrap:g}"
+        return s
+
+    def material(self):
+        return technique_material(self.technique, self.roughness, self.color, self.wrap)
+
+
+@dataclass
+class LightSpec:
+    kind: str                       # quad, disk, point, spot, sun
+    location: tuple
+    energy: float
+    size: float = 1.0
+    size_y: float | None = None     # RECTANGLE / ELLIPSE when given
+    target: tuple = (0.0, 0.0, 0.0)
+    color: tuple = WHITE
+    spot_size: float = 0.9
+    spot_blend: float = 0.3
+
+    def describe(self):
+        x, y, z = self.location
+        s = f"{self.kind} at ({x:.2f}, {y:.2f}, {z:.2f})"
+        if self.kind in ("quad", "disk"):
+            s += f" size {self.size:.2f}" + (f" x {self.size_y:.2f}" if self.size_y else "")
+        return s + f", energy {self.energy:g}"
+
+
+@dataclass
+class Case:
+    name: str
+    lights: list
+    variants: list
+    columns: int = 4
+    description: str = ""
+    tags: dict = field(default_factory=dict)
+
+    @property
+    def light_kinds(self):
+        return sorted({l.kind for l in self.lights})
+
+
+CELL = 2.2                          # world units per sphere cell
+#: Least distance of a sphere centre in front of an area light's plane (sphere radius 1).
+MIN_CLEARANCE = 1.6
+
+
+def sphere_centres(case):
+    n = len(case.variants)
+    cols = min(case.columns, n)
+    rows = math.ceil(n / cols)
+    out = []
+    for i in range(n):
+        r, c = divmod(i, cols)
+        out.append(((c - 0.5 * (cols - 1)) * CELL, 0.0, (0.5 * (rows - 1) - r) * CELL))
+    return out, cols, rows
+
+
+def _spherical(rng, dist, elev_lo, elev_hi, az_lo=-70.0, az_hi=70.0):
+    """A point at ``dist`` from the origin on the camera's side (-Y), elevation/azimuth in degrees."""
+    el = math.radians(rng.uniform(elev_lo, elev_hi))
+    az = math.radians(rng.uniform(az_lo, az_hi))
+    return (dist * math.cos(el) * math.sin(az), -dist * math.cos(el) * math.cos(az), dist * math.sin(el))
+
+
+def _area_power(kind, size, size_y, dist, target_radiance):
+    """Power giving the light the radiance that makes ~target irradiance at distance ``dist``."""
+    area = size * (size_y or size) * (math.pi / 4 if kind == "disk" else 1.0)
+    return float(target_radiance * math.pi * area)
+
+
+def _keep_in_front(light, centres, clearance=MIN_CLEARANCE):
+    """Move the light back along its axis until every sphere centre lies at least ``clearance``
+    in front of its plane: no sphere crosses the light's plane (a unit sphere at clearance 1.6 keeps
+    0.6 from it), so every shading point is on the lit side or sees the light from behind as a
+    whole; spheres still see the light partly below their horizon near the terminator."""
+    loc = np.array(light.location, np.float64)
+    axis = np.array(light.target, np.float64) - loc
+    axis /= np.linalg.norm(axis)
+    depth = min(float((np.asarray(c) - loc) @ axis) for c in centres)
+    if depth < clearance:
+        shift = axis * (depth - clearance)
+        light.location = tuple(float(x) for x in loc + shift)
+        light.target = tuple(float(x) for x in np.array(light.target) + shift)
+
+
+def build_cases(seed=0, quick=False):
+    """The built-in suite.  ``quick``: a small subset (the CI test's)."""
+    rng = np.random.default_rng(seed)
+    closure_row = [Variant("lambert"), Variant("ggx", 0.25), Variant("ggx", 0.5), Variant("ggx", 0.8),
+                   Variant("turquin", 0.6), Variant("fdez_aguera", 0.6), Variant("dielectric", 0.4),
+                   Variant("metal", 0.5)]
+    brute_row = [Variant("cod", 0.5), Variant("wrapped", 0.5, wrap=0.5), Variant("cloth", 0.5),
+                 Variant("sheen", 0.5), Variant("kulla_conty", 0.7), Variant("turquin_color", 0.7),
+                 Variant("lambert"), Variant("ggx", 0.5)]
+    cases = []
+    # area lights: (kind, size, size_y, distance, tilt deg, elevation range)
+    configs = [("quad", 1.0, None, 3.0, 0.0), ("quad", 2.5, 1.2, 2.5, 25.0), ("quad", 0.5, None, 4.0, 10.0),
+               ("quad", 4.0, 2.0, 2.2, 40.0), ("disk", 1.2, None, 3.0, 0.0), ("disk", 3.0, 1.5, 2.4, 30.0),
+               ("disk", 0.6, None, 4.0, 15.0)]
+    if quick:
+        configs = [("quad", 1.5, None, 3.0, 15.0), ("disk", 1.5, None, 3.0, 15.0)]
+    for i, (kind, size, size_y, dist, tilt) in enumerate(configs):
+        loc = _spherical(rng, dist, -20.0, 60.0)
+        # tilt: aim at a point off the sphere centre, perpendicular to the light's direction
+        off = np.cross(np.array(loc), [0.0, 0.0, 1.0])
+        off = off / max(np.linalg.norm(off), 1e-9) * dist * math.tan(math.radians(tilt))
+        target = tuple(float(x) for x in off)
+        # radiance so the brightest pixel is O(1): L A / d^2 ~ 1
+        radiance = dist * dist / (size * (size_y or size))
+        light = LightSpec(kind, tuple(float(x) for x in loc), _area_power(kind, size, size_y, dist, radiance),
+                          size, size_y, target)
+        _keep_in_front(light, sphere_centres(Case("", [], closure_row, columns=4))[0])
+        # every sphere of a row sees the light from a different direction; the row's width
+        # (4 cells, 8.8 units) puts the outer spheres' lights at up to ~70 deg off their centre
+        cases.append(Case(f"{kind}{i}_closures", [light], closure_row if not quick else
+                          [Variant("lambert"), Variant("ggx", 0.5), Variant("turquin", 0.6)],
+                          columns=4, description=f"{light.describe()}, tilt {tilt:g} deg: Cycles-closure techniques",
+                          tags={"light": kind, "tilt": tilt, "distance": dist}))
+        if not quick and i in (0, 1, 4, 5):
+            cases.append(Case(f"{kind}{i}_brute", [light], brute_row, columns=4,
+                              description=f"{light.describe()}, tilt {tilt:g} deg: techniques without a "
+                                          "Cycles closure, against brute-force integrals",
+                              tags={"light": kind, "tilt": tilt, "distance": dist}))
+    if quick:
+        cases.append(Case("quad_brute", [cases[0].lights[0]],
+                          [Variant("cod", 0.5), Variant("cloth", 0.5), Variant("kulla_conty", 0.7)], columns=3,
+                          description="brute-force subset", tags={"light": "quad"}))
+        cases.append(Case("point", [LightSpec("point", (1.5, -3.0, 1.5), 400.0)],
+                          [Variant("lambert"), Variant("ggx", 0.5)], columns=2,
+                          description="point light, radius 0", tags={"light": "point"}))
+        return cases
+    # roughness sweep, dielectric and metal, under a rectangle
+    sweep = [Variant("dielectric", r) for r in (0.1, 0.3, 0.5, 0.7, 0.9)] + \
+            [Variant("metal", r, (0.95, 0.64, 0.54)) for r in (0.1, 0.3, 0.5, 0.7, 0.9)]
+    light = LightSpec("quad", (1.5, -3.0, 2.0), _area_power("quad", 2.0, 1.0, 3.0, 4.5), 2.0, 1.0)
+    cases.append(Case("quad_sweep", [light], sweep, columns=5,
+                      description=f"{light.describe()}: dielectric (top) and metal (bottom), r = 0.1 ... 0.9",
+                      tags={"light": "quad"}))
+    light = LightSpec("disk", (-2.0, -2.5, 1.5), _area_power("disk", 1.5, None, 3.0, 4.0), 1.5)
+    cases.append(Case("disk_sweep", [light], sweep, columns=5,
+                      description=f"{light.describe()}: dielectric (top) and metal (bottom), r = 0.1 ... 0.9",
+                      tags={"light": "disk"}))
+    # punctual lights (deterministic in Cycles: radius 0 / angle 0)
+    punctual_row = [Variant("lambert"), Variant("ggx", 0.3), Variant("ggx", 0.7), Variant("turquin", 0.6),
+                    Variant("dielectric", 0.4), Variant("metal", 0.5)]
+    cases.append(Case("point", [LightSpec("point", (1.5, -3.0, 1.5), 400.0)], punctual_row, columns=3,
+                      description="point light, radius 0", tags={"light": "point"}))
+    cases.append(Case("spot", [LightSpec("spot", (-1.0, -4.0, 2.0), 800.0, spot_size=1.0, spot_blend=0.3)],
+                      punctual_row, columns=3, description="spot light, radius 0, cone 57 deg, blend 0.3",
+                      tags={"light": "spot"}))
+    cases.append(Case("sun", [LightSpec("sun", (0.0, -3.0, 3.0), 2.0, target=(0.3, 0.0, -0.2))], punctual_row,
+                      columns=3, description="sun, angle 0", tags={"light": "sun"}))
+    return cases
+
+
+# --- scene ------------------------------------------------------------------------------------
+
+def _aim(obj, target):
+    import mathutils
+
+    direction = mathutils.Vector(target) - obj.location
+    obj.rotation_mode = "QUATERNION"
+    obj.rotation_quaternion = direction.to_track_quat("-Z", "Y")
+
+
+def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
+    """Reset the file; lights, spheres with RT Lit materials, camera.  Returns (scene, spheres)."""
+    import bpy
+
+    import validate_energy
+    from rt_lookdev.addon import materials
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = bpy.context.scene
+    for i, spec in enumerate(case.lights):
+        ltype = {"quad": "AREA", "disk": "AREA"}.get(spec.kind, spec.kind.upper())
+        data = bpy.data.lights.new(f"L{i}_{spec.kind}", ltype)
+        data.energy = spec.energy
+        data.color = spec.color
+        if spec.kind in ("quad", "disk"):
+            shape = {"quad": ("SQUARE", "RECTANGLE"), "disk": ("DISK", "ELLIPSE")}[spec.kind]
+            data.shape = shape[1] if spec.size_y else shape[0]
+            data.size = spec.size
+            data.size_y = spec.size_y or spec.size
+        elif spec.kind in ("point", "spot"):
+            data.shadow_soft_size = 0.0
+            if spec.kind == "spot":
+                data.spot_size, data.spot_blend = spec.spot_size, spec.spot_blend
+        else:
+            data.angle = 0.0
+        obj = bpy.data.objects.new(f"L{i}_{spec.kind}", data)
+        obj.location = spec.location
+        obj.visible_camera = False
+        scene.collection.objects.link(obj)
+        _aim(obj, spec.target)
+    materials.sync_scene_lights(scene)
+
+    centres, cols, rows = sphere_centres(case)
+    mesh = validate_energy._uv_sphere_mesh(bpy, "RTL_val_sphere", segments, rings)
+    spheres = []
+    for i, (variant, centre) in enumerate(zip(case.variants, centres)):
+        me = mesh.copy()
+        mat = bpy.data.materials.new(f"RTL_val_{i}")
+        materials.assign_rt_lit(mat, variant.features, scene, lut_dir)
+        node = mat.node_tree.nodes["RT Lit"]
+        for k, v in variant.material().items():
+            node.inputs[k].default_value = tuple(v) + (1.0,) if isinstance(v, tuple) else v
+        me.materials.append(mat)
+        ob = bpy.data.objects.new(f"RTL_val_sphere_{i}", me)
+        ob.location = centre
+        for attr in ("visible_glossy", "visible_diffuse", "visible_transmission", "visible_volume_scatter",
+                     "visible_shadow"):
+            setattr(ob, attr, False)
+        scene.collection.objects.link(ob)
+        spheres.append(ob)
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.data.type = "ORTHO"
+    cam.data.sensor_fit = "HORIZONTAL"
+    cam.data.ortho_scale = CELL * cols
+    cam.data.clip_start, cam.data.clip_end = 0.1, 100.0
+    cam.location = (0.0, -20.0, 0.0)
+    cam.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    scene.world = None
+    scene.render.resolution_x = cell_px * cols
+    scene.render.resolution_y = cell_px * rows
+    return scene, spheres
+
+
+def sphere_index(case, position, normal):
+    """Per pixel: index of the sphere hit (-1 for background)."""
+    centres, _, _ = sphere_centres(case)
+    hit = np.linalg.norm(normal, axis=-1) > 0.5
+    idx = np.full(hit.shape, -1, np.int64)
+    for i, c in enumerate(centres):
+        idx[hit & (np.linalg.norm(position - np.asarray(c), axis=-1) < 1.05)] = i
+    return idx
+
+
+# --- (b) numpy -------------------------------------------------------------------------------
+
+def scene_light_params(scene):
+    from rt_lookdev.addon import materials
+
+    return [(kind, materials.light_parameters(obj, kind)) for obj, kind in materials.scene_lights(scene)]
+
+
+def _numpy_material(variant):
+    from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS
+
+    out = {}
+    for name, sock in RT_LIT_INPUTS.items():
+        v = sock.default
+        if name in variant.material():
+            v = variant.material()[name]
+        if sock.kind == "float":
+            out[name] = float(v)
+        elif name == "Normal":
+            out[name] = np.zeros(3)
+        else:
+            out[name] = np.array(list(v)[:3], dtype=np.float64)
+    return out
+
+
+def numpy_radiance(case, scene, passes, index):
+    """(b): the RT Lit materials evaluated in numpy (float64) at the render's pixels."""
+    from engine_parity import camera_incoming
+    from rt_lookdev.addon import materials
+    from rt_lookdev.core.materials import rt_lit
+
+    pos = passes["Position"].astype(np.float64)
+    nrm = passes["Normal"].astype(np.float64)
+    out = np.zeros(pos.shape)
+    lights = scene_light_params(scene)
+    for i, variant in enumerate(case.variants):
+        mine = index == i
+        if not mine.any():
+            continue
+        mat = scene.objects[f"RTL_val_sphere_{i}"].data.materials[0]
+        params = {k: (np.array(v) if isinstance(v, tuple) else v)
+                  for k, v in materials.material_parameters(mat).items()}
+        geo = {"Position": pos[mine], "Geometry Normal": nrm[mine], "Incoming": camera_incoming(scene, pos[mine])}
+        out[mine] = rt_lit.rt_lit_radiance(variant.features, params, geo, lights)
+    return out
+
+
+# --- (c) Cycles ground truth -----------------------------------------------------------------
+
+def _closure_material(variant, name):
+    import bpy
+
+    mat = bpy.data.materials.new(name)
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    m = variant.material()
+    t = variant.technique
+
+    def glossy(dist):
+        g = nt.nodes.new("ShaderNodeBsdfGlossy")
+        g.distribution = dist
+        g.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+        g.inputs["Roughness"].default_value = m["Roughness"]
+        g.inputs["Anisotropy"].default_value = 0.0
+        return g
+
+    def metallic(f0):
+        g = nt.nodes.new("ShaderNodeBsdfMetallic")
+        g.distribution = "GGX"
+        g.fresnel_type = "F82"
+        g.inputs["Base Color"].default_value = tuple(f0) + (1.0,)
+        g.inputs["Edge Tint"].default_value = (1.0, 1.0, 1.0, 1.0)
+        g.inputs["Roughness"].default_value = m["Roughness"]
+        g.inputs["Anisotropy"].default_value = 0.0
+        return g
+
+    def diffuse(color):
+        d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+        d.inputs["Color"].default_value = tuple(color) + (1.0,)
+        d.inputs["Roughness"].default_value = 0.0
+        return d
+
+    if t == "lambert":
+        shader = diffuse(m["Base Color"])
+    elif t == "ggx":
+        shader = glossy("GGX")
+    elif t in ("turquin", "fdez_aguera"):
+        shader = glossy("MULTI_GGX")
+    elif t == "metal":
+        shader = metallic(m["Base Color"])
+    elif t == "dielectric":
+        from rt_lookdev.core.materials.rt_lit import dielectric_f0
+
+        f0 = float(dielectric_f0(np.float64(m["IOR"]), np.float64(m["Specular IOR Level"])))
+        add = nt.nodes.new("ShaderNodeAddShader")
+        nt.links.new(metallic((f0, f0, f0)).outputs[0], add.inputs[0])
+        nt.links.new(diffuse(m["Base Color"]).outputs[0], add.inputs[1])
+        shader = add
+    else:
+        raise ValueError(f"{t} has no Cycles closure")
+    nt.links.new(shader.outputs[0], out.inputs["Surface"])
+    return mat
+
+
+def configure_truth_render(scene, samples, seed, threads=2):
+    from rt_lookdev.addon.render_setup import configure_cycles_measurement
+
+    configure_cycles_measurement(scene, samples, seed, threads)
+    c = scene.cycles
+    c.max_bounces = 0                 # direct light only: spheres are convex and see nothing else
+    c.blur_glossy = 0.0
+    c.caustics_reflective = True
+    c.caustics_refractive = True
+    vl = scene.view_layers[0]
+    vl.use_pass_combined = True
+    vl.use_pass_normal = True
+    vl.use_pass_position = False
+    s = scene.render.image_settings
+    s.media_type = "MULTI_LAYER_IMAGE"
+    s.file_format = "OPEN_EXR_MULTILAYER"
+    s.color_depth = "32"
+    s.exr_codec = "ZIP"
+
+
+def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
+    """(c) for the Cycles-closure variants: one render per seed.  Returns ([rgb per seed], seconds
+    per seed, normal) or None when no variant uses Cycles."""
+    import bpy
+
+    import validate_energy
+
+    todo = [i for i, v in enumerate(case.variants) if v.truth == "cycles"]
+    if not todo:
+        return None
+    saved = []
+    for i, ob in enumerate(spheres):
+        saved.append((ob.data.materials[0], ob.hide_render))
+        if i in todo:
+            ob.data.materials[0] = _closure_material(case.variants[i], f"RTL_truth_{i}")
+        else:
+            ob.hide_render = True
+    images, seconds, normal = [], [], None
+    try:
+        for seed in seeds:
+            configure_truth_render(scene, samples, seed, threads)
+            path = Path(folder) / f"truth_seed{seed}.exr"
+            seconds.append(validate_energy.render_exr(scene, path))
+            rgb, nrm = validate_energy.read_passes(path)
+            images.append(rgb)
+            normal = nrm
+    finally:
+        for ob, (mat, hidden) in zip(spheres, saved):
+            ob.data.materials[0] = mat
+            ob.hide_render = hidden
+    return images, seconds, normal
+
+
+# --- (c) brute-force ground truth -------------------------------------------------------------
+
+def _area_geometry(kind, params):
+    from rt_lookdev.core import lights as core_lights
+
+    out = core_lights.LIGHT_DATA[kind](**{k: np.float64(v) for k, v in params.items()})
+    out = {k: np.asarray(v, np.float64) for k, v in out.items()}
+    if kind == "quad":
+        return {"corners": np.stack([out[f"p{i}"] for i in range(4)]), "radiance": out["Radiance"]}
+    return {"center": out["Center"], "u": out["Axis U"], "v": out["Axis V"], "radiance": out["Radiance"]}
+
+
+def _rule(kind, geo, p, clip_normal, panels, order):
+    """Points relative to p (M, 3), area weights (M,), unit light normal, or None if unlit."""
+    from rt_lookdev.core.ltc import reference
+
+    if kind == "quad":
+        rel = geo["corners"] - p
+        normal = reference.newell_normal(rel)
+        if rel[0] @ normal < 0.0:
+            return None
+        x, w = reference.polygon_rule(rel, clip_normal, panels, order)
+    else:
+        c = geo["center"] - p
+        normal = np.cross(geo["u"], geo["v"])
+        if c @ normal < 0.0:
+            return None
+        x, w = reference.disk_rule(c, geo["u"], geo["v"], clip_normal, panels, order)
+    return x, w, normal / np.linalg.norm(normal)
+
+
+def _surface(features, material, n, v):
+    from rt_lookdev.core.materials import rt_lit
+    from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS
+
+    return rt_lit.SURFACE(**{k: material[k] for k in RT_LIT_INPUTS}, **{"Geometry Normal": n, "Incoming": v})
+
+
+def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, panels=8, order=8, only=None, chunk=24):
+    """(c) for the brute-force variants on at most ``pixel_cap`` seeded pixels per sphere.
+
+    Returns (image with NaN where not computed, quadrature error estimate image, seconds per
+    variant).  The error estimate is |I(panels) - I(panels / 2)| (reference._converged's check).
+    Pixels are evaluated in chunks: the rule's points of ``chunk`` pixels go through one call of
+    the shading function (numpy, float64)."""
+    from engine_parity import camera_incoming
+    from rt_lookdev.core import lights as core_lights
+    from rt_lookdev.core.materials import rt_lit
+
+    pos = passes["Position"].astype(np.float64)
+    nrm = passes["Normal"].astype(np.float64)
+    img = np.full(pos.shape, np.nan)
+    qerr = np.full(pos.shape, np.nan)
+    lights = scene_light_params(scene)
+    seconds = {}
+    levels = (panels, max(panels // 2, 1))
+    for i, variant in enumerate(case.variants):
+        if (only is None and variant.truth != "brute") or (only is not None and i not in only):
+            continue
+        t0 = time.perf_counter()
+        ys, xs = np.nonzero(index == i)
+        if len(ys) > pixel_cap:
+            pick = np.sort(rng.choice(len(ys), pixel_cap, replace=False))
+            ys, xs = ys[pick], xs[pick]
+        features = variant.features
+        material = _numpy_material(variant)
+        shade = rt_lit.shade_function("sun", features)
+        unclipped = features.diffuse == "wrapped"
+        P = pos[ys, xs]
+        N = nrm[ys, xs] / np.linalg.norm(nrm[ys, xs], axis=-1, keepdims=True)
+        V = camera_incoming(scene, P)
+        surface = _surface(features, material, N, V)
+        sums = np.zeros((len(levels), len(ys), 3))
+        for kind, params in lights:
+            if kind in ("quad", "disk"):
+                geo = _area_geometry(kind, params)
+                for lev, level in enumerate(levels):
+                    for start in range(0, len(ys), chunk):
+                        owner, dirs, irr = [], [], []
+                        for k in range(start, min(start + chunk, len(ys))):
+                            rule = _rule(kind, geo, P[k], None if unclipped else N[k], level, order)
+                            if rule is None or len(rule[1]) == 0:
+                                continue
+                            xr, w, ln = rule
+                            r = np.linalg.norm(xr, axis=-1)
+                            owner.append(np.full(len(w), k))
+                            dirs.append(xr / r[:, None])
+                            irr.append((w * np.abs(xr @ ln) / r ** 3)[:, None] * geo["radiance"])
+                        if owner:
+                            owner = np.concatenate(owner)
+                            rad = _shade(shade, surface, owner, np.concatenate(dirs), np.concatenate(irr))
+                            for ch in range(3):
+                                sums[lev, :, ch] += np.bincount(owner, rad[:, ch], minlength=len(ys))
+            else:
+                # punctual: the true BRDF at the one light direction (no integral)
+                args = {k: np.full(len(ys), v, np.float64) for k, v in params.items()}
+                if "Position" in core_lights.LIGHT_DATA[kind].input_sockets:
+                    args["Position"] = P
+                light = core_lights.LIGHT_DATA[kind](**args)
+                L = np.broadcast_to(np.asarray(light["L"], np.float64), P.shape)
+                E = np.broadcast_to(np.asarray(light["Irradiance"], np.float64), P.shape)
+                sums += _shade(shade, surface, np.arange(len(ys)), L, E)[None]
+        img[ys, xs] = sums[0]
+        qerr[ys, xs] = np.abs(sums[0] - sums[1])
+        seconds[i] = time.perf_counter() - t0
+    return img, qerr, seconds
+
+
+def _shade(shade, surface, owner, l, irradiance):
+    """The material's punctual shading (radiance, (M, 3)) for directions l (M, 3) with irradiance
+    (M, 3); surface values per pixel, ``owner`` the pixel of each direction."""
+    kw = {}
+    for name in shade.input_sockets:
+        if name == "L":
+            kw[name] = l
+        elif name == "Irradiance":
+            kw[name] = irradiance
+        elif name == "Position":
+            kw[name] = np.zeros(l.shape)
+        else:
+            val = np.asarray(surface[name], np.float64)
+            if val.ndim == 0:
+                kw[name] = np.full(len(owner), float(val))
+            elif val.ndim == 1 and val.shape[0] == 3 and name not in ("N", "V"):
+                kw[name] = np.broadcast_to(val, l.shape)
+            else:
+                kw[name] = val[owner]
+    return np.asarray(shade(**kw)["Radiance"], np.float64).reshape(-1, 3)
+
+
+# --- metrics ------------------------------------------------------------------------------------
+
+def ab_metrics(a, b, mask, near_zero=1e-2):
+    """(a) vs (b): max relative difference where |b| >= near_zero, max abs difference below."""
+    av, bv = a[mask].astype(np.float64), b[mask].astype(np.float64)
+    err = np.abs(av - bv)
+    big = np.abs(bv) >= near_zero
+    return {"max_rel": float((err[big] / np.abs(bv[big])).max()) if big.any() else 0.0,
+            "max_abs_near_zero": float(err[~big].max()) if (~big).any() else 0.0,
+            "values": int(av.size), "values_rel": int(big.sum()),
+            "finite": bool(np.all(np.isfinite(a[mask])) and np.all(np.isfinite(b[mask])))}
+
+
+def truth_metrics(a, c, mask, floor_frac, c_pair=None, samples_total=None, qerr=None):
+    """(a) vs (c) over the values (pixels x channels) of ``mask`` where c > floor_frac * max(c).
+
+    ``c_pair``: the two seed images (c is their mean) for the Monte Carlo noise: per value
+    sigma_c = |c1 - c2| / 2, an unbiased one-sample estimate of the noise of c (so the
+    "noise_*" figures are what the error statistics would be if the node render were exact).
+    """
+    av, cv = a[mask].astype(np.float64).ravel(), c[mask].astype(np.float64).ravel()
+    ok = np.isfinite(cv)
+    if not ok.any():
+        return None
+    cmax = float(np.max(cv[ok]))
+    floor = floor_frac * cmax
+    sel = ok & (cv > floor)
+    if not sel.any():
+        return None
+    rel = np.abs(av[sel] - cv[sel]) / cv[sel]
+    out = {"values": int(sel.sum()), "floor": floor, "c_max": cmax,
+           "mean": float(rel.mean()), "median": float(np.median(rel)), "p90": float(np.percentile(rel, 90)),
+           "max": float(rel.max()), "rmse": float(np.sqrt(np.mean((av[sel] - cv[sel]) ** 2))),
+           "rms_rel": float(np.sqrt(np.mean(rel ** 2))),
+           "bias_rel": float(np.mean((av[sel] - cv[sel]) / cv[sel]))}
+    if c_pair is not None:
+        c1, c2 = (x[mask].astype(np.float64).ravel()[sel] for x in c_pair)
+        sig = np.abs(c1 - c2) / 2.0
+        nrel = sig / cv[sel]
+        out.update({"noise_mean": float(nrel.mean()), "noise_median": float(np.median(nrel)),
+                    "noise_p90": float(np.percentile(nrel, 90)), "noise_rms_rel": float(np.sqrt(np.mean(nrel ** 2))),
+                    "noise_rmse": float(np.sqrt(np.mean(sig ** 2)))})
+        # Node render's own (systematic) error: the RMS relative error with the noise's share removed.
+        own = math.sqrt(max(out["rms_rel"] ** 2 - out["noise_rms_rel"] ** 2, 0.0))
+        out["node_rms_rel_excess"] = own
+        if samples_total:
+            # Cycles noise ~ 1/sqrt(spp): samples for Cycles' own RMS relative noise to equal the node
+            # render's error.  Below the noise floor of this comparison the figure is a lower bound.
+            resolved = own > 0.5 * out["noise_rms_rel"]
+            eff = own if resolved else 0.5 * out["noise_rms_rel"]
+            out["cycles_spp_to_match"] = float(samples_total * (out["noise_rms_rel"] / eff) ** 2) if eff > 0 else None
+            out["cycles_spp_to_match_is_lower_bound"] = not resolved
+    if qerr is not None:
+        qv = qerr[mask].astype(np.float64).reshape(-1)[sel] / cv[sel]
+        out.update({"quadrature_rel_median": float(np.median(qv)), "quadrature_rel_max": float(qv.max())})
+    return out
