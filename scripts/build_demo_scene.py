@@ -138,7 +138,7 @@ def build_demo_scene(lut_dir=None, resolution=256):
     scene.camera = cam
     r = scene.render
     r.resolution_x = resolution
-    r.resolution_y = int(round(resolution * 3.0 / len(ROUGHNESS)))
+    r.resolution_y = resolution          # square (256^2 by default): the rows sit in the middle
     r.resolution_percentage = 100
     return spheres
 

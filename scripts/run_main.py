@@ -14,7 +14,9 @@ Steps (each prints what it does):
 5. Demo lookdev scene (scripts/build_demo_scene.py, scripts/demo_report.py): RT Lit spheres under a
    quad and a disk light, saved to <out>/demo/lookdev_demo.blend; node counts, Cycles render time,
    one EEVEE render compared with Cycles.
-6. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
+6. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
+   brute-force integrals, per technique, with an HTML report in <out>/validation/.
+7. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
 """
 from __future__ import annotations
 
@@ -49,7 +51,7 @@ def _progress(group, done, total):
 
 
 def step_luts(lut_dir):
-    print(f"[1/6] LUTs in {lut_dir}", flush=True)
+    print(f"[1/7] LUTs in {lut_dir}", flush=True)
     records = bake.bake(lut_dir, progress=_progress, log=lambda line: print("      " + line, flush=True))
     status = catalog.lut_status(lut_dir)
     return {"records": [{"group": r.group, "state": r.state, "seconds": round(r.seconds, 2)} for r in records],
@@ -58,7 +60,7 @@ def step_luts(lut_dir):
 
 
 def step_numpy_checks(lut_dir):
-    print("[2/6] numpy energy checks", flush=True)
+    print("[2/7] numpy energy checks", flush=True)
     t0 = time.perf_counter()
     tables = lookup.EnergyTables(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -89,7 +91,7 @@ def step_numpy_checks(lut_dir):
 
 
 def step_demo(out_dir, lut_dir, eevee=True):
-    print("[5/6] demo lookdev scene: build, node counts, Cycles and EEVEE renders", flush=True)
+    print("[5/7] demo lookdev scene: build, node counts, Cycles and EEVEE renders", flush=True)
     import demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee,
@@ -98,8 +100,21 @@ def step_demo(out_dir, lut_dir, eevee=True):
     return result
 
 
+def step_validation(out_dir, lut_dir):
+    print("[6/7] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)", flush=True)
+    import validate
+
+    argv = ["--out", str(out_dir / "validation")] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
+    result = validate.run(validate.parse_args(argv), log=lambda line: print("      " + line, flush=True))
+    lines = ["| check | measured | threshold | |", "|---|---|---|---|"]
+    lines += [f"| {c['name']} | {c['measured']} | {c['threshold']} | {'ok' if c['ok'] else '**FAIL**'} |"
+              for c in result["checks"]]
+    return {"passed": bool(result["passed"]), "checks": result["checks"],
+            "summary_markdown": "\n".join(lines) + f"\n\nFull report: `{out_dir / 'validation' / 'report.html'}`."}
+
+
 def step_render(out_dir, lut_dir, resolution, samples):
-    print("[4/6] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
+    print("[4/7] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
     import validate_energy  # imports bpy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -110,7 +125,7 @@ def step_render(out_dir, lut_dir, resolution, samples):
 
 
 def step_ltc(lut_dir):
-    print("[3/6] LTC area lights: random quads and disks vs brute force", flush=True)
+    print("[3/7] LTC area lights: random quads and disks vs brute force", flush=True)
     import benchmark_ltc
 
     t0 = time.perf_counter()
@@ -172,6 +187,9 @@ def write_report(report, out_dir):
     demo = report.get("demo")
     lines += ["## Demo lookdev scene (RT Lit materials)", ""]
     lines += [demo["summary_markdown"], ""] if demo else ["Skipped (--skip-render).", ""]
+    val = report.get("validation")
+    lines += ["## Validation suite (node render, numpy, Cycles ground truth)", ""]
+    lines += [val["summary_markdown"], ""] if val else ["Skipped (--skip-render).", ""]
     lines += [f"Overall: **{'PASS' if report['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
@@ -193,15 +211,17 @@ def main(argv=None):
         return 1
     report["numpy_checks"] = step_numpy_checks(args.lut_dir)
     report["ltc"] = step_ltc(args.lut_dir)
-    report["render"] = report["demo"] = None
+    report["render"] = report["demo"] = report["validation"] = None
     if not args.skip_render:
         report["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples)
         report["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee)
+        report["validation"] = step_validation(args.out, args.lut_dir)
     report["passed"] = bool(report["luts"]["passed"] and report["numpy_checks"]["passed"] and report["ltc"]["passed"]
                             and (report["render"] is None or report["render"].get("passed", False))
-                            and (report["demo"] is None or report["demo"].get("passed", False)))
+                            and (report["demo"] is None or report["demo"].get("passed", False))
+                            and (report["validation"] is None or report["validation"].get("passed", False)))
     report["seconds"] = time.perf_counter() - t0
-    print("[6/6] report", flush=True)
+    print("[7/7] report", flush=True)
     write_report(report, args.out)
     print((args.out / "report.md").read_text())
     print(f"report written to {args.out / 'report.md'} and report.json")

