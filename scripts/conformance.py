@@ -43,18 +43,9 @@ def _setup_render(scene, w, h, path, engine="CYCLES"):
         scene.cycles.max_bounces = 0
     else:
         configure_eevee_measurement(scene, samples=1, black_world=False)
-    r = scene.render
-    r.resolution_x, r.resolution_y, r.resolution_percentage = w, h, 100
-    r.dither_intensity = 0.0
-    r.use_compositing = False
-    r.use_sequencer = False
-    s = r.image_settings
-    s.media_type = "IMAGE"
-    s.file_format = "OPEN_EXR"
-    s.color_depth = "32"
-    s.color_mode = "RGBA"
-    s.exr_codec = "ZIP"
-    r.filepath = str(path)
+    from engine_parity import _output_settings
+
+    _output_settings(scene, w, h, path)
 
 
 def _read_exr(path):

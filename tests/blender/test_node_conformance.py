@@ -16,6 +16,8 @@ for _p in (_HERE, _HERE.parent / "core"):
         sys.path.insert(0, str(_p))
 
 from conformance import LAST_RENDER_SECONDS, render_group_outputs  # noqa: E402
+from function_conformance import ATOL, NEAR_ZERO, RTOL  # noqa: E402
+from function_conformance import compare as _compare  # noqa: E402
 from test_ir import TECHNIQUES, _inputs  # noqa: E402
 
 from rt_lookdev.core import diffuse  # noqa: E402
@@ -25,19 +27,6 @@ from rt_lookdev.core.ir.numpy_backend import evaluate, node_count, topological_o
 pytestmark = pytest.mark.blender
 
 SIZE = 64
-RTOL = 1e-4
-ATOL = 1e-6
-NEAR_ZERO = 1e-2
-
-
-def _compare(got, ref):
-    """(max relative error where |ref| >= NEAR_ZERO, max absolute error where |ref| < NEAR_ZERO)."""
-    got, ref = np.asarray(got, np.float64), np.asarray(ref, np.float64)
-    err = np.abs(got - ref)
-    big = np.abs(ref) >= NEAR_ZERO
-    rel = float((err[big] / np.abs(ref[big])).max()) if big.any() else 0.0
-    absolute = float(err[~big].max()) if (~big).any() else 0.0
-    return rel, absolute
 
 
 def _check(name, got, ref):
