@@ -445,7 +445,7 @@ def ensure_tree(name, outputs, input_names, sockets=None, internal_inputs=None, 
     (``internal_inputs``); rebuilt only when the graph's structure or ``stamp_extra`` changes."""
     from ..core.ir.expr import Function
 
-    fn = Function(name, {n: FLOAT for n in []}, outputs)
+    fn = Function(name, {}, outputs)         # for its structure hash
     stamp = f"{EMITTER_VERSION}:{fn.key}:{sorted(input_names)}:{stamp_extra}:{shader_sums!r}"
     ng = bpy.data.node_groups.get(name)
     if ng is not None and ng.get("rtl_stamp") == stamp:

@@ -23,6 +23,15 @@ def _summarise(statuses, states):
     return "; ".join(parts)
 
 
+def _lut_directory_exists(cls, context):
+    """poll() of the operators that read the LUT folder: it must exist."""
+    lut_dir = preferences.lut_directory(context)
+    if not lut_dir.is_dir():
+        cls.poll_message_set(f"LUT directory does not exist: {lut_dir}")
+        return False
+    return True
+
+
 class RTL_OT_lut_status(bpy.types.Operator):
     """Check that the baked lookup tables exist and match the current code"""
 
@@ -32,11 +41,7 @@ class RTL_OT_lut_status(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        lut_dir = preferences.lut_directory(context)
-        if not lut_dir.is_dir():
-            cls.poll_message_set(f"LUT directory does not exist: {lut_dir}")
-            return False
-        return True
+        return _lut_directory_exists(cls, context)
 
     def execute(self, context):
         lut_dir = preferences.lut_directory(context)
@@ -129,11 +134,7 @@ class RTL_OT_add_node_groups(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        lut_dir = preferences.lut_directory(context)
-        if not lut_dir.is_dir():
-            cls.poll_message_set(f"LUT directory does not exist: {lut_dir}")
-            return False
-        return True
+        return _lut_directory_exists(cls, context)
 
     def execute(self, context):
         from ..core.lut import lookup

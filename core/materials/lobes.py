@@ -28,20 +28,12 @@ from ..lut.lookup import energy_lut_uv, lut_coordinate
 # --- energy tables as traceable lookups -----------------------------------------------------
 
 
-@functools.lru_cache(maxsize=8)
-def _energy_lut(name, lut_dir):
-    from ..lut import exr_io
-
-    spec = catalog.TABLES[name]
-    table, _ = exr_io.read_table(lut_dir / spec.filename, spec.name, spec.shape)
-    return op.Lut(name, table)
-
-
 def energy_lut(name):
-    """The named energy table of the active LUT folder (``lookup.active_lut_dir``)."""
+    """The named energy table of the active LUT folder, from ``lookup.default_energy_tables``
+    (loaded once; ``lookup.use_lut_dir`` switches the folder)."""
     from ..lut import lookup
 
-    return _energy_lut(name, lookup.active_lut_dir())
+    return op.Lut(name, lookup.default_energy_tables().tables[name])
 
 
 def one_minus_e(mu, roughness):

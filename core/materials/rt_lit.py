@@ -24,9 +24,9 @@ from .. import multiscatter
 from .. import shading_ops as op
 from ..fresnel import fresnel_average
 from ..ir.functions import NodeFunction
-from ..ir.interface import Socket, color, factor, vector
+from ..ir.interface import color, factor, vector
 from . import lobes
-from .rt_lit_interface import RT_LIT_INPUTS, RT_LIT_OUTPUTS, Features
+from .rt_lit_interface import RT_LIT_INPUTS
 
 LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun")
 
@@ -50,10 +50,6 @@ SURFACE_OUTPUTS = {
     "Cloth Color": color((1.0, 1.0, 1.0), "Cloth colour"),
     "Emission": color((0.0, 0.0, 0.0), "Emitted radiance"),
 }
-
-
-def _rgb(c):
-    return c
 
 
 # Principled BSDF v2 (Blender 4.0+ manual, "Principled BSDF"): dielectric F0 from the IOR,
@@ -180,13 +176,6 @@ def shade_function(kind, features):
 
 # --- the whole material ---------------------------------------------------------------------------
 
-def light_input_names(index, kind):
-    """Names of the RT Lit graph inputs that carry light ``index``'s driver values."""
-    from .. import lights
-
-    return {p: f"Light {index} {p}" for p in lights.LIGHT_DATA[kind].input_sockets if p != "Position"}
-
-
 def rt_lit_radiance(features, material, geometry, lights_in_scene):
     """Outgoing radiance of the RT Lit material (3-vector) plus its emission.
 
@@ -219,6 +208,3 @@ def rt_lit_radiance_parts(features, material, geometry, lights_in_scene):
         parts.append(fn(**_lobe_args(fn, available))["Radiance"])
     return parts
 
-
-__all__ = ["SURFACE", "rt_lit_radiance", "shade_function", "combine_lobes", "Features", "RT_LIT_OUTPUTS",
-           "Socket"]

@@ -106,12 +106,7 @@ def _principled_material(bpy, name="Lookdev", *, subsurface=SUBSURFACE_WEIGHT):
     return mat
 
 
-def _value(socket):
-    value = socket.default_value
-    try:
-        return tuple(value)
-    except TypeError:
-        return value
+from rt_lookdev.addon.convert import _value  # noqa: E402  (the same reading as the module under test)
 
 
 def _close(a, b, tol=1e-6):
