@@ -268,7 +268,8 @@ def stored_features(material):
         data = data.to_dict() if hasattr(data, "to_dict") else dict(data)
         features = Features.from_dict(data)
         return Features(specular=str(features.specular), diffuse=str(features.diffuse),
-                        sheen=bool(features.sheen), cloth=bool(features.cloth))
+                        sheen=bool(features.sheen), cloth=bool(features.cloth),
+                        environment_ms=str(features.environment_ms))
     except (TypeError, ValueError):
         return None
 
@@ -596,6 +597,14 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
                         default=Features().sheen)
     cloth: BoolProperty(name="Cloth", description="Build the group with the Ashikhmin cloth lobe",
                         default=Features().cloth)
+    environment_ms: EnumProperty(
+        name="World Multiscattering",
+        description="Fdez-Aguera multiple scattering under the world: lit by the irradiance (the paper) or "
+                    "by the prefiltered radiance (the talk's approximation)",
+        items=(('irradiance', "Irradiance", "Fdez-Aguera 2019: FssEss x radiance + FmsEms x irradiance"),
+               ('radiance', "Radiance", "The talk: (FssEss + FmsEms) x prefiltered radiance")),
+        default=Features().environment_ms,
+    )
 
     @classmethod
     def poll(cls, context):
@@ -605,19 +614,24 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
         return True
 
     def features(self):
-        return Features(specular=self.specular, diffuse=self.diffuse, sheen=self.sheen, cloth=self.cloth)
+        return Features(specular=self.specular, diffuse=self.diffuse, sheen=self.sheen, cloth=self.cloth,
+                        environment_ms=self.environment_ms)
 
     def invoke(self, context, event):
         stored = stored_features(_active_material(context))
         if stored is not None:
             self.specular, self.diffuse = stored.specular, stored.diffuse
             self.sheen, self.cloth = stored.sheen, stored.cloth
+            self.environment_ms = stored.environment_ms
         return context.window_manager.invoke_props_dialog(self)
 
     def draw(self, context):
         layout = self.layout
         layout.prop(self, "target")
         layout.prop(self, "specular")
+        sub = layout.row()
+        sub.active = self.specular == 'fdez_aguera'
+        sub.prop(self, "environment_ms")
         layout.prop(self, "diffuse")
         row = layout.row()
         row.prop(self, "sheen")

@@ -9,6 +9,10 @@
   ``rt_lit.rt_lit_radiance`` traced with the scene's lights: Geometry > Position / Normal /
   Incoming and the lights group feed it inside the tree; its interface is RT_LIT_INPUTS.
   Groups are stamped with the structure hash of their graph and rebuilt only when it changes.
+- The World term (core/materials/world.py) is part of the group when the shared "RTL World" group
+  exists with its bake record (``addon/world.py`` ``sync_world``): its outputs feed the "World ..."
+  inputs, and the prefiltered image is a table of the graph.  Without it (the world has no image)
+  nothing of the world is built or loaded.
 """
 from __future__ import annotations
 
@@ -23,6 +27,7 @@ from ..core.materials.rt_lit_interface import RT_LIT_INPUTS, RT_LIT_OUTPUTS, Fea
 from . import node_emit
 
 SCENE_LIGHTS_GROUP = "RTL Scene Lights"
+WORLD_GROUP = "RTL World"          # built by addon/world.py sync_world
 RT_LIT_PREFIX = "RT Lit"
 FEATURES_KEY = "rtl_features"
 
@@ -123,8 +128,26 @@ def sync_scene_lights(scene):
     return records
 
 
-def _graph_for(features, records):
-    """Trace the RT Lit material for these lights: (outputs, material input names, light input names)."""
+def world_environment():
+    """(WorldEnvironment, record) of the synced world, or None when "RTL World" is absent."""
+    from ..core.materials.world import WorldEnvironment
+
+    ng = bpy.data.node_groups.get(WORLD_GROUP)
+    record = dict(ng["rtl_world"]) if ng is not None and "rtl_world" in ng.keys() else None
+    if not record:
+        return None
+    try:
+        env = WorldEnvironment.load(record["prefiltered"], record["table"])
+    except Exception as exc:  # missing or corrupt cache file: say what to do
+        raise RuntimeError(f"the baked world environment {record['prefiltered']} cannot be read ({exc}); "
+                           "run RT Lookdev > Sync World again") from exc
+    node_emit.register_image(record["table"], record["prefiltered"])
+    return env, record
+
+
+def _graph_for(features, records, env=None):
+    """Trace the RT Lit material for these lights (and the world's environment ``env``, or None):
+    (outputs, material input names, light and world input names)."""
     g = Graph()
     material = {}
     for name, sock in RT_LIT_INPUTS.items():
@@ -138,10 +161,25 @@ def _graph_for(features, records):
             params[param] = g.input(f"Light {index} {param}")
             light_inputs.append(f"Light {index} {param}")
         lights_in.append((kind, params))
-    parts = rt_lit.rt_lit_radiance_parts(features, material, geometry, lights_in)
+    world_in = None
+    if env is not None:
+        from ..core.materials.world import WORLD_PARAMETERS
+
+        params = {}
+        for name, sock in WORLD_PARAMETERS.items():
+            params[name] = g.input(f"World {name}", FLOAT if sock.kind == "float" else VECTOR)
+            light_inputs.append(f"World {name}")
+        world_in = (env, params)
+    parts = rt_lit.rt_lit_radiance_parts(features, material, geometry, lights_in, world_in)
     outputs = {"Radiance": parts[0]}
     for i, part in enumerate(parts):
-        outputs["Material Emission" if i == 0 else f"Light {i - 1} Radiance"] = part
+        if i == 0:
+            name = "Material Emission"
+        elif world_in is not None and i == len(parts) - 1:
+            name = "World Radiance"
+        else:
+            name = f"Light {i - 1} Radiance"
+        outputs[name] = part
         if i:
             outputs["Radiance"] = outputs["Radiance"] + part
     return outputs, list(RT_LIT_INPUTS), light_inputs
@@ -162,7 +200,9 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None):
     for entry in lights_ng.get("rtl_lights", []):
         name, kind = entry.rsplit(":", 1)
         records.append((name, kind))
-    outputs, material_names, light_names = _graph_for(features, records)
+    world = world_environment()
+    env, world_record = world if world is not None else (None, None)
+    outputs, material_names, light_names = _graph_for(features, records, env)
     shader_sums = {"Shader": [n for n in outputs if n != "Radiance"]}
     cache = {}
 
@@ -188,10 +228,22 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None):
 
     internal = {"Position": geometry_socket("Position"), "Geometry Normal": geometry_socket("Normal"),
                 "Incoming": geometry_socket("Incoming")}
-    internal.update({n: light_socket(n) for n in light_names})
+    def world_socket(name):
+        def make(nodes, links):
+            node = cache.get("world")
+            if node is None:
+                node = cache["world"] = nodes.new("ShaderNodeGroup")
+                node.node_tree = bpy.data.node_groups[WORLD_GROUP]
+                node.location = (-400.0, -600.0)
+                node.label = WORLD_GROUP
+            return node.outputs[name]
+        return make
+
+    internal.update({n: (world_socket(n) if n.startswith("World ") else light_socket(n)) for n in light_names})
     sockets = (RT_LIT_INPUTS, RT_LIT_OUTPUTS)
     ng, _ = node_emit.ensure_tree(rt_lit_group_name(features), outputs, material_names, sockets,
-                                  internal_inputs=internal, stamp_extra=repr(records), lut_dir=lut_dir,
+                                  internal_inputs=internal,
+                                  stamp_extra=repr((records, world_record and world_record["table"])), lut_dir=lut_dir,
                                   shader_sums=shader_sums,
                                   description=f"RT Lit lookdev material ({features.label()}): outgoing "
                                               "radiance from every scene light, for an Emission shader")

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from collections import Counter
 
+from pathlib import Path
+
 import numpy as np
 
 import bpy
@@ -59,13 +61,30 @@ def _socket(sockets, identifier):
     raise KeyError(identifier)
 
 
+#: Tables that are not in the LUT catalog (baked environments): name -> EXR path (``register_image``).
+_EXTRA_IMAGES = {}
+
+
+def register_image(table, path):
+    """Make ``table`` (e.g. a baked environment, ``env_<hash>``) loadable by ``lut_image`` from ``path``."""
+    _EXTRA_IMAGES[table] = Path(path)
+
+
+def _table_path(table, lut_dir):
+    if table in catalog.TABLES:
+        return (lut_dir or catalog.default_lut_dir()) / catalog.TABLES[table].filename
+    if table in _EXTRA_IMAGES:
+        return _EXTRA_IMAGES[table]
+    raise KeyError(f"no image for table {table!r}: not a catalog LUT and not registered (sync the world again)")
+
+
 def lut_image(table, lut_dir=None):
     """The Blender image of a catalog table, loaded once (as ../shared/reference/blender_addon.md
     §3.1 prescribes: float, Non-Color, channel-packed alpha), packed into the .blend, fake user."""
     name = f"RTL_{table}"
     image = bpy.data.images.get(name)
     if image is None:
-        path = (lut_dir or catalog.default_lut_dir()) / catalog.TABLES[table].filename
+        path = _table_path(table, lut_dir)
         image = bpy.data.images.load(str(path), check_existing=False)
         image.name = name
         image.colorspace_settings.name = "Non-Color"

@@ -189,6 +189,12 @@ def cos(a):
     return np.cos(_arr(a))
 
 
+def sin(a):
+    if is_expr(a):
+        return _node("sine", a)
+    return np.sin(_arr(a))
+
+
 def atan2(y, x):
     """Angle of (x, y) in [-pi, pi] (Math "Arctan2": atan2(first input, second input))."""
     if is_expr(y, x):
@@ -234,6 +240,21 @@ def lut_sample(lut, u, v, channel):
     from .lut.lookup import sample_bilinear
 
     return sample_bilinear(lut.table, u, v)[..., channel]
+
+
+def texel_fetch(lut, u, v, channel):
+    """Channel of the texel of ``lut`` that contains (u, v), no filtering (Image Texture, Closest,
+    EXTEND): texel (floor(u W), floor(v H)) clamped to the table, row 0 at v = 0.  Traced: a
+    ``texel`` node."""
+    if is_expr(u, v):
+        g = graph_of(u, v)
+        g.luts.setdefault(lut.name, lut.table)
+        return g.make("texel", (u, v), (("table", lut.name), ("channel", channel)))
+    table = np.asarray(lut.table)
+    h, w = table.shape[:2]
+    i = np.clip(np.floor(np.asarray(u, np.float64) * w), 0, w - 1).astype(np.int64)
+    j = np.clip(np.floor(np.asarray(v, np.float64) * h), 0, h - 1).astype(np.int64)
+    return table[j, i][..., channel]
 
 
 _LUT_FUNCTIONS = {}

@@ -43,6 +43,9 @@ SURFACE_OUTPUTS = {
     "V": vector("Unit direction towards the viewer", "NONE"),
     "Roughness": factor(0.5, "Blender roughness r"),
     "F0": color((0.04, 0.04, 0.04), "Specular reflectance at normal incidence"),
+    "Dielectric F0": color((0.04, 0.04, 0.04), "F0 of the dielectric part (IOR, level, tint)"),
+    "Metal F0": color((0.8, 0.8, 0.8), "F0 of the metallic part (base colour)"),
+    "Metallic": factor(0.0, "Blend from dielectric to metal"),
     "Albedo": color((0.8, 0.8, 0.8), "Diffuse albedo"),
     "Wrap": factor(0.0, "Wrapped-diffuse amount"),
     "Sheen Color": color((0.0, 0.0, 0.0), "Sheen weight times tint"),
@@ -65,9 +68,12 @@ def _surface(**kw):
     base, tint = kw["Base Color"], kw["Specular Tint"]
     n_in = kw["Normal"]
     n = op.vselect(op.greater(op.dot(n_in, n_in), 0.0), op.normalize(n_in), op.normalize(kw["Geometry Normal"]))
-    f0 = op.scale(tint, dielectric_f0(kw["IOR"], kw["Specular IOR Level"]) * (1.0 - metallic)) \
-        + op.scale(base, metallic)
+    f0_dielectric = op.scale(tint, dielectric_f0(kw["IOR"], kw["Specular IOR Level"]))
+    f0 = op.scale(f0_dielectric, 1.0 - metallic) + op.scale(base, metallic)
     return {
+        "Dielectric F0": f0_dielectric,
+        "Metal F0": base,
+        "Metallic": metallic,
         "N": n,
         "V": op.normalize(kw["Incoming"]),
         "Roughness": op.saturate(kw["Roughness"]),
@@ -176,22 +182,23 @@ def shade_function(kind, features):
 
 # --- the whole material ---------------------------------------------------------------------------
 
-def rt_lit_radiance(features, material, geometry, lights_in_scene):
+def rt_lit_radiance(features, material, geometry, lights_in_scene, world=None):
     """Outgoing radiance of the RT Lit material (3-vector) plus its emission.
 
     ``material``: RT_LIT_INPUTS name -> value; ``geometry``: Position, Geometry Normal, Incoming;
-    ``lights_in_scene``: list of (kind, {driver parameter name -> value}).
+    ``lights_in_scene``: list of (kind, {driver parameter name -> value}); ``world``: None (no world
+    contribution) or (``world.WorldEnvironment``, {``world.WORLD_PARAMETERS`` name -> value}).
     """
-    parts = rt_lit_radiance_parts(features, material, geometry, lights_in_scene)
+    parts = rt_lit_radiance_parts(features, material, geometry, lights_in_scene, world)
     total = parts[0]
     for part in parts[1:]:
         total = total + part
     return total
 
 
-def rt_lit_radiance_parts(features, material, geometry, lights_in_scene):
-    """[the material's emission, radiance from light 0, from light 1, ...]: the terms of
-    ``rt_lit_radiance`` (in nodes, one Emission closure each)."""
+def rt_lit_radiance_parts(features, material, geometry, lights_in_scene, world=None):
+    """[the material's emission, radiance from light 0, from light 1, ..., (the world)]: the terms of
+    ``rt_lit_radiance`` (in nodes, one Emission closure each); the world's term comes last."""
     from .. import lights
 
     surface = SURFACE(**{k: material[k] for k in RT_LIT_INPUTS},
@@ -206,5 +213,13 @@ def rt_lit_radiance_parts(features, material, geometry, lights_in_scene):
         fn = shade_function(kind, features)
         available = dict(surface, Position=geometry["Position"], **light)
         parts.append(fn(**_lobe_args(fn, available))["Radiance"])
+    if world is not None:
+        from . import world as world_term
+
+        env, params = world
+        fn = world_term.shade_world_function(features, env)
+        args = {k: surface[k] for k in world_term.WORLD_SURFACE}
+        args.update({f"World {k}": params[k] for k in world_term.WORLD_PARAMETERS})
+        parts.append(fn(**args)["Radiance"])
     return parts
 

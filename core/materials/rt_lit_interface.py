@@ -12,6 +12,9 @@ from ..ir.interface import Socket, color, factor, scalar, vector
 
 SPECULAR_MODELS = ("single", "turquin", "fdez_aguera", "kulla_conty")
 DIFFUSE_MODELS = ("lambert", "cod", "wrapped")
+#: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
+#: the prefiltered radiance (the talk's approximation); core/materials/world.py.
+ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")
 
 #: Input name -> socket, in interface order.  Names follow the Principled BSDF where one exists,
 #: so a conversion maps them one to one.
@@ -55,12 +58,15 @@ class Features:
     diffuse: str = "cod"             # one of DIFFUSE_MODELS
     sheen: bool = False
     cloth: bool = False
+    environment_ms: str = "irradiance"   # one of ENVIRONMENT_MS_FORMS (Fdez-Aguera under the world)
 
     def __post_init__(self):
         if self.specular not in SPECULAR_MODELS:
             raise ValueError(f"specular model must be one of {SPECULAR_MODELS}, got {self.specular!r}")
         if self.diffuse not in DIFFUSE_MODELS:
             raise ValueError(f"diffuse model must be one of {DIFFUSE_MODELS}, got {self.diffuse!r}")
+        if self.environment_ms not in ENVIRONMENT_MS_FORMS:
+            raise ValueError(f"environment_ms must be one of {ENVIRONMENT_MS_FORMS}, got {self.environment_ms!r}")
 
     def as_dict(self):
         return asdict(self)
@@ -72,5 +78,7 @@ class Features:
 
     def label(self):
         parts = [self.specular.replace("_", "-"), self.diffuse]
+        if self.specular == "fdez_aguera" and self.environment_ms != "irradiance":
+            parts[0] += f" ({self.environment_ms})"
         parts += [p for p, on in (("sheen", self.sheen), ("cloth", self.cloth)) if on]
         return ", ".join(parts)

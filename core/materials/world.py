@@ -1,0 +1,383 @@
+"""The World term of the RT Lit material: image-based lighting from the scene's environment.
+
+The talk's "Light Type" tables list what each technique needs under an environment; this module is
+that column, written with ``core.shading_ops`` so one source gives numpy evaluation and node groups:
+
+* diffuse from L2 spherical harmonics (``core/indirect.py``): Lambert irradiance, the normalised
+  wrapped lobe, and the talk's LTC-rotated cosine lobe for the CoD multiscattering diffuse;
+* specular by the split sum (Karis 2013): GGX-prefiltered radiance (``core/environment/prefilter.py``)
+  looked up along the dominant specular direction (Lagarde & de Rousiers 2014), times the environment
+  BRDF (F0 scale + bias); multiple scattering by the material's specular model (below), evaluated
+  separately for the dielectric and the metallic F0 and then mixed by Metallic;
+* cloth and sheen by the same LTC-rotated cosine lobe as the CoD diffuse, with their own tables.
+
+Frames
+------
+SH coefficients and the prefiltered image are in the image's frame at strength 1 (the bake).  The
+world shows L(d) = Strength image(R d), R the Mapping node's Euler XYZ rotation (Blender: R = Rz Ry Rx,
+applied to the direction before the Environment Texture), so N and V are rotated into the image frame
+once (``RTL World Rotation``) and the result is multiplied by Strength.
+
+Multiple scattering under the environment (specular model of the material, F90 = 1)
+-----------------------------------------------------------------------------------
+With (A, B) the split-sum table at (mu_v, r), FssEss = F0 A + B, E = A + B, P the prefiltered
+radiance, I = E(n)/pi the cosine-weighted mean radiance (SH):
+
+* ``single``       FssEss P                                            (Karis 2013, eq. 4)
+* ``turquin``      FssEss (1 + F0 (1 - E)/E) P                         (Turquin 2019, eq. 16)
+* ``fdez_aguera``  irradiance form: FssEss P + FmsEms I                (Fdez-Aguera 2019, eq. 11-16)
+                   radiance form (the talk): (FssEss + FmsEms) P       (``Features.environment_ms``)
+* ``kulla_conty``  FssEss P + F_ms (1 - E) I: the Kulla-Conty lobe's directional albedo is exactly
+                   1 - E(mu_v) (Kulla & Conty 2017, slide 18), its angular shape ~ cosine, so it is lit
+                   by I; F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)) as for the lights.
+
+Mixing the two F0 *after* these formulas is what three.js (#32190) and Bevy (#23203) got wrong:
+they are non-linear in F0, so a mixed F0 = lerp(F0_dielectric, base colour, metallic) over-brightens
+partly metallic surfaces.  The punctual and area lights of RT Lit still use the mixed F0 (their
+models are linear in F0 except Turquin's and Fdez-Aguera's scales; documented in docs/conventions.md).
+
+Specular dominant direction (Lagarde & de Rousiers 2014, "Moving Frostbite to PBR", listing 22):
+lerp(N, R, s (sqrt(s) + alpha)) with s = 1 - alpha, alpha = r^2, R the mirror direction.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import indirect, multiscatter
+from .. import shading_ops as op
+from ..conventions import alpha_from_roughness
+from ..fresnel import fresnel_average
+from ..ir.functions import NodeFunction
+from ..ir.interface import Socket, color, factor, vector
+from ..lut.lookup import energy_lut_uv
+from . import lobes
+
+PI = math.pi
+
+SH_NAMES = tuple(f"SH {i}" for i in range(9))
+#: The world's parameters as the RT Lit group receives them ("World <name>" inputs, from the shared
+#: "RTL World" group written by addon/world.py).
+WORLD_PARAMETERS = {
+    **{name: color((0.0, 0.0, 0.0), f"L2 SH radiance coefficient {i} (R&H 2001 order), image frame, "
+                                    "strength 1") for i, name in enumerate(SH_NAMES)},
+    "Strength": Socket("float", 1.0, description="The Background node's Strength"),
+    "Rotation": vector("Euler XYZ rotation (radians) of the world's Mapping node", "EULER"),
+}
+
+#: Tables of the LTC-rotated lobes (core/lut/catalog.py).
+COD_TABLE = "ltc_cod_diffuse"
+CLOTH_TABLE = "ltc_cloth"
+SHEEN_TABLE_ROUGHNESS = 0.5       # the talk's sheen: the CoD table at r = 0.5 (core/ltc/shading.py)
+
+
+# --- the prefiltered environment --------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class WorldEnvironment:
+    """A baked environment as shading code needs it: the prefiltered levels as one table (the EXR's
+    rows, Blender order: row 0 at the bottom; level k in rows [k H, (k + 1) H)) and their roughness."""
+    name: str                 # table / image name, e.g. env_<content hash>
+    table: np.ndarray         # (L H, W, 4) float32
+    roughness_levels: tuple
+
+    @classmethod
+    def load(cls, prefiltered_path, name):
+        import json
+
+        from ..lut import exr_io
+
+        table, meta = exr_io.read_table(prefiltered_path)
+        levels = tuple(float(r) for r in json.loads(meta["roughness_levels"]))
+        return cls(name, np.asarray(table, np.float32), levels)
+
+    @classmethod
+    def from_bake(cls, bake):
+        """From a ``core.environment.prefilter.EnvironmentBake``; named env_<source hash[:12]>."""
+        return cls.load(bake.prefiltered_path, f"env_{bake.source_hash[:12]}")
+
+    def __post_init__(self):
+        levels = np.asarray(self.roughness_levels, np.float64)
+        if len(levels) < 2 or not np.allclose(levels, np.linspace(levels[0], levels[-1], len(levels))):
+            raise ValueError(f"prefiltered levels must be >= 2 evenly spaced roughnesses, got {self.roughness_levels}")
+        if self.table.shape[0] % len(levels):
+            raise ValueError(f"prefiltered table of {self.table.shape[0]} rows is not {len(levels)} levels")
+
+    @property
+    def lut(self):
+        return op.Lut(self.name, self.table)
+
+    def __hash__(self):
+        return hash((self.name, self.table.shape, self.roughness_levels))
+
+    def __eq__(self, other):
+        return isinstance(other, WorldEnvironment) and (self.name, self.table.shape, self.roughness_levels) == \
+            (other.name, other.table.shape, other.roughness_levels)
+
+
+def _wrap(t):
+    """t - floor(t): a REPEAT texture coordinate fetched with EXTEND (exact at texel centres)."""
+    return t - op.floor(t)
+
+
+# Blender's equirectangular mapping (core/environment/equirect.py, Cycles direction_to_equirectangular):
+# u = 0.5 - atan2(y, x) / (2 pi), v = 1 - acos(z) / pi.  Bilinear within a level (REPEAT in u, rows
+# clamped to the level), linear across the two levels around r: 8 exact Closest fetches (EEVEE's Linear
+# filtering picks mipmaps from screen-space derivatives; core/shading_ops.lut_sample).
+def _prefiltered_body(env):
+    lut = env.lut
+    n_levels = len(env.roughness_levels)
+    h = env.table.shape[0] // n_levels
+    w = env.table.shape[1]
+    r_lo, r_hi = env.roughness_levels[0], env.roughness_levels[-1]
+
+    def body(Direction, Roughness):
+        d = op.normalize(Direction)
+        x, y, z = (op.component(d, i) for i in range(3))
+        u = 0.5 - op.atan2(y, x) * (1.0 / (2.0 * PI))
+        v = 1.0 - op.acos(z) * (1.0 / PI)
+        xs = u * w - 0.5
+        x0 = op.floor(xs)
+        fx = xs - x0
+        cols = (_wrap((x0 + 0.5) * (1.0 / w)), _wrap((x0 + 1.5) * (1.0 / w)))
+        ys = op.clamp(v * h - 0.5, 0.0, h - 1.0)
+        y0 = op.minimum(op.floor(ys), h - 2.0)
+        fy = ys - y0
+        t = (op.clamp(Roughness, r_lo, r_hi) - r_lo) * ((n_levels - 1) / (r_hi - r_lo))
+        k0 = op.minimum(op.floor(t), n_levels - 2.0)
+        fk = t - k0
+        total = None
+        for dk, wk in ((0.0, 1.0 - fk), (1.0, fk)):
+            for dy, wy in ((0.0, 1.0 - fy), (1.0, fy)):
+                row = ((k0 + dk) * h + y0 + dy + 0.5) * (1.0 / (n_levels * h))
+                for col, wx in ((cols[0], 1.0 - fx), (cols[1], fx)):
+                    weight = wk * wy * wx
+                    texel = op.vec3(*(op.texel_fetch(lut, col, row, c) for c in range(3)))
+                    term = op.scale(texel, weight)
+                    total = term if total is None else total + term
+        return {"Radiance": total}
+
+    return body
+
+
+@functools.lru_cache(maxsize=8)
+def prefiltered_function(env):
+    """``RTL Environment <name>``: GGX-prefiltered radiance of ``env`` in a direction (image frame) at a
+    roughness, strength 1."""
+    return NodeFunction(f"RTL Environment {env.name}", _prefiltered_body(env),
+                        {"Direction": vector("Lookup direction, image frame", "NONE", hide_value=True),
+                         "Roughness": factor(0.5, "Blender roughness r")},
+                        {"Radiance": color((0.0, 0.0, 0.0), "Prefiltered radiance (strength 1)")},
+                        f"Split-sum GGX prefiltered radiance of {env.name} (8 exact texel fetches)")
+
+
+# --- rotation into the image frame ------------------------------------------------------------------
+
+# Blender's Euler XYZ: R = Rz(c) Ry(b) Rx(a) (Mapping node, type Point or Vector), applied to directions.
+def euler_xyz_rows(rotation):
+    sa, ca = op.sin(op.component(rotation, 0)), op.cos(op.component(rotation, 0))
+    sb, cb = op.sin(op.component(rotation, 1)), op.cos(op.component(rotation, 1))
+    sc, cc = op.sin(op.component(rotation, 2)), op.cos(op.component(rotation, 2))
+    return (op.vec3(cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa),
+            op.vec3(sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa),
+            op.vec3(-1.0 * sb, cb * sa, cb * ca))
+
+
+def _rotation(N, V, Rotation):
+    rows = euler_xyz_rows(Rotation)
+    return {"N": op.mat_vec(rows, N), "V": op.mat_vec(rows, V)}
+
+
+_DIR = vector("Unit direction, world space", "NONE", hide_value=True)
+WORLD_ROTATION = NodeFunction(
+    "RTL World Rotation", _rotation, {"N": _DIR, "V": _DIR, "Rotation": WORLD_PARAMETERS["Rotation"]},
+    {"N": vector("N in the image frame", "NONE"), "V": vector("V in the image frame", "NONE")},
+    "World directions to the environment image's frame (the Mapping node's Euler XYZ rotation)")
+
+
+# --- SH lobes ---------------------------------------------------------------------------------------
+
+def _sh_lobe(**kw):
+    coeffs = [kw[name] for name in SH_NAMES]
+    zonal = (1.0, kw["Lambda 1"], kw["Lambda 2"])
+    return {"Radiance": indirect.sh_zonal_eval(coeffs, op.normalize(kw["Axis"]), zonal)}
+
+
+SH_LOBE = NodeFunction(
+    "RTL SH Lobe", _sh_lobe,
+    {**{name: WORLD_PARAMETERS[name] for name in SH_NAMES},
+     "Axis": vector("Lobe axis (normalised inside)", "NONE", hide_value=True),
+     "Lambda 1": Socket("float", 2.0 / 3.0, description="Funk-Hecke factor of band 1 (band 0: 1)"),
+     "Lambda 2": Socket("float", 0.25, description="Funk-Hecke factor of band 2")},
+    {"Radiance": color((0.0, 0.0, 0.0), "int L(w) k(axis.w) dw for the normalised zonal lobe k")},
+    "SH environment seen through a normalised zonal lobe (Funk-Hecke; R&H 2001 basis)")
+
+
+def sh_lobe(coeffs, axis, zonal):
+    kw = dict(zip(SH_NAMES, coeffs))
+    return SH_LOBE(**kw, Axis=axis, **{"Lambda 1": zonal[1], "Lambda 2": zonal[2]})["Radiance"]
+
+
+def _ltc_axis_and_magnitude(table, n, v, roughness):
+    from ..lut import lookup
+
+    tables = lookup.default_ltc_tables()
+    mu = op.saturate(op.dot(n, v))
+    c, magnitude, fresnel = tables.lookup(table, mu, roughness)
+    from ..ltc import polygon
+
+    axis = indirect.ltc_lobe_axis(c, polygon.local_frame(n, v), "talk")
+    return axis, magnitude, fresnel
+
+
+# The talk, "LTCs for Spherical Harmonics": the cosine lobe rotated by the LTC inverse matrix of the
+# BRDF (axis c1 T1 + c3 N), evaluated against the SH, scaled by the LTC magnitude.
+def _ltc_lobe_function(title, table, description, fixed_roughness=None, use_fresnel=False):
+    def body(**kw):
+        r = fixed_roughness if fixed_roughness is not None else kw["Roughness"]
+        axis, magnitude, fresnel = _ltc_axis_and_magnitude(table, kw["N"], kw["V"], r)
+        amount = fresnel * PI if use_fresnel else magnitude
+        return {"Axis": op.normalize(axis), "Magnitude": amount}
+
+    inputs = {"N": _DIR, "V": _DIR}
+    if fixed_roughness is None:
+        inputs["Roughness"] = factor(0.5, "Blender roughness r")
+    return NodeFunction(f"RTL SH-LTC {title}", body, inputs,
+                        {"Axis": vector("Cosine lobe axis, unit", "NONE"),
+                         "Magnitude": Socket("float", 0.0, description="Scale of the lobe")}, description)
+
+
+SH_LTC_COD = _ltc_lobe_function("CoD Diffuse", COD_TABLE, "The CoD WWII diffuse's LTC: lobe axis and magnitude")
+SH_LTC_CLOTH = _ltc_lobe_function("Cloth", CLOTH_TABLE, "The Ashikhmin cloth's LTC: lobe axis and magnitude")
+SH_LTC_SHEEN = _ltc_lobe_function("Sheen", COD_TABLE, "Disney sheen as the talk: the CoD LTC at r = 0.5, "
+                                  "magnitude pi x its Fresnel channel", SHEEN_TABLE_ROUGHNESS, use_fresnel=True)
+
+
+# --- specular ---------------------------------------------------------------------------------------
+
+def split_sum(mu_v, roughness):
+    """(scale A, bias B) of the split-sum environment BRDF at (mu_v, r) (table ggx_split_sum)."""
+    u, v = energy_lut_uv(mu_v, roughness)
+    lut = lobes.energy_lut("ggx_split_sum")
+    return op.lut_sample(lut, u, v, 0), op.lut_sample(lut, u, v, 1)
+
+
+def _channel_specular(model, environment_ms):
+    """Per colour channel: f0, A, B, P, I (floats) -> outgoing specular radiance (module docstring)."""
+    def spec(f0, a, b, p, i, om_avg):
+        fss_ess = f0 * a + b
+        if model == "single":
+            return fss_ess * p
+        e = a + b
+        if model == "turquin":
+            return fss_ess * multiscatter.turquin_compensation(f0, e) * p
+        if model == "fdez_aguera":
+            fss, fms = multiscatter.fdez_aguera_terms(f0, a, b)
+            return fss * p + fms * (p if environment_ms == "radiance" else i)
+        if model == "kulla_conty":
+            f_ms = multiscatter.kulla_conty_fresnel_factor(fresnel_average(f0), om_avg)
+            return fss_ess * p + f_ms * (1.0 - e) * i
+        raise ValueError(f"unknown specular model {model!r}")
+    return spec
+
+
+@functools.lru_cache(maxsize=None)
+def specular_function(model, environment_ms="irradiance"):
+    """``RTL World Specular (<model>)``: one F0's specular under the environment."""
+    channel = _channel_specular(model, environment_ms)
+
+    def body(**kw):
+        om_avg = lobes.one_minus_e_avg(kw["Roughness"]) if model == "kulla_conty" else 0.0
+        parts = [channel(op.component(kw["F0"], c), kw["Scale"], kw["Bias"], op.component(kw["Prefiltered"], c),
+                         op.component(kw["Irradiance"], c), om_avg) for c in range(3)]
+        return {"Specular": op.vec3(*parts)}
+
+    inputs = {"F0": color((0.04, 0.04, 0.04), "Specular reflectance at normal incidence"),
+              "Scale": Socket("float", 1.0, description="Split-sum scale A at (N.V, r)"),
+              "Bias": Socket("float", 0.0, description="Split-sum bias B at (N.V, r)"),
+              "Prefiltered": color((0.0, 0.0, 0.0), "Prefiltered radiance along the dominant direction"),
+              "Irradiance": color((0.0, 0.0, 0.0), "Cosine-weighted mean radiance E(N)/pi")}
+    if model == "kulla_conty":
+        inputs["Roughness"] = factor(0.5, "Blender roughness r")
+    label = model.replace("_", "-") + (f", {environment_ms} form" if model == "fdez_aguera" else "")
+    return NodeFunction(f"RTL World Specular ({label})", body, inputs,
+                        {"Specular": color((0.0, 0.0, 0.0), "Outgoing specular radiance")},
+                        f"Split-sum specular under the environment, {label}")
+
+
+def dominant_direction(n, v, roughness):
+    """Lagarde & de Rousiers 2014, listing 22: lerp(N, R, s (sqrt(s) + alpha)), s = 1 - alpha."""
+    alpha = alpha_from_roughness(roughness)
+    s = 1.0 - alpha
+    f = s * (op.sqrt(s) + alpha)
+    r = op.scale(n, 2.0 * op.dot(n, v)) - v
+    return op.normalize(n + op.scale(r - n, f))
+
+
+# --- the whole world term ---------------------------------------------------------------------------
+
+WORLD_SURFACE = ("N", "V", "Roughness", "Dielectric F0", "Metal F0", "Metallic", "Albedo", "Wrap",
+                 "Sheen Color", "Cloth Weight", "Cloth Color")
+
+
+def world_radiance(features, env, surface, params):
+    """Radiance towards the viewer from the environment (3-vector).
+
+    ``surface``: RTL Surface outputs (at least ``WORLD_SURFACE``); ``params``: ``WORLD_PARAMETERS``
+    names -> values; ``env``: the ``WorldEnvironment``."""
+    rotated = WORLD_ROTATION(N=surface["N"], V=surface["V"], Rotation=params["Rotation"])
+    n, v = rotated["N"], rotated["V"]
+    coeffs = [params[name] for name in SH_NAMES]
+    r = surface["Roughness"]
+    irradiance = sh_lobe(coeffs, n, indirect.COSINE_LOBE_ZONAL)
+
+    # diffuse
+    if features.diffuse == "lambert":
+        diffuse = irradiance
+    elif features.diffuse == "wrapped":
+        diffuse = sh_lobe(coeffs, n, indirect.wrapped_lobe_zonal(surface["Wrap"]))
+    else:
+        lobe = SH_LTC_COD(N=n, V=v, Roughness=r)
+        diffuse = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
+
+    # specular, per F0, then mixed
+    scale_a, bias_b = split_sum(op.saturate(op.dot(n, v)), r)
+    prefiltered = prefiltered_function(env)(Direction=dominant_direction(n, v, r), Roughness=r)["Radiance"]
+    spec_fn = specular_function(features.specular, getattr(features, "environment_ms", "irradiance"))
+    extra = {"Roughness": r} if features.specular == "kulla_conty" else {}
+    common = dict(Scale=scale_a, Bias=bias_b, Prefiltered=prefiltered, Irradiance=irradiance, **extra)
+    m = surface["Metallic"]
+    spec = op.scale(spec_fn(F0=surface["Dielectric F0"], **common)["Specular"], 1.0 - m) \
+        + op.scale(spec_fn(F0=surface["Metal F0"], **common)["Specular"], m)
+
+    if features.cloth:
+        lobe = SH_LTC_CLOTH(N=n, V=v, Roughness=r)
+        cloth = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
+        w = surface["Cloth Weight"]
+        spec = op.scale(spec, 1.0 - w) + op.scale(op.vmul(surface["Cloth Color"], cloth), w)
+    total = spec + op.vmul(surface["Albedo"], diffuse)
+    if features.sheen:
+        lobe = SH_LTC_SHEEN(N=n, V=v)
+        sheen = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
+        total = total + op.vmul(surface["Sheen Color"], sheen)
+    return op.scale(total, params["Strength"])
+
+
+@functools.lru_cache(maxsize=16)
+def shade_world_function(features, env):
+    """``RTL Shade World (<features>)``: the environment's radiance towards the viewer."""
+    from .rt_lit import SURFACE_OUTPUTS
+
+    def shade(**kw):
+        surface = {k: kw[k] for k in WORLD_SURFACE}
+        params = {k: kw[f"World {k}"] for k in WORLD_PARAMETERS}
+        return {"Radiance": world_radiance(features, env, surface, params)}
+
+    inputs = {k: SURFACE_OUTPUTS[k] for k in WORLD_SURFACE}
+    inputs.update({f"World {k}": s for k, s in WORLD_PARAMETERS.items()})
+    return NodeFunction(f"RTL Shade World ({features.label()}; {env.name})", shade, inputs,
+                        {"Radiance": color((0.0, 0.0, 0.0), "Radiance towards the viewer from the world")},
+                        f"The world's image-based lighting on the RT Lit material ({features.label()})")
