@@ -115,3 +115,44 @@ def test_shade_world_groups_match_numpy(empty_scene, lut_dir, environment):
             _check(fn, lut_dir)
             counts = node_emit.tree_node_counts(node_emit.ensure_function_group(fn, lut_dir))
             assert max(counts.values()) <= node_emit.MAX_GROUP_NODES, counts
+
+
+def test_shade_world_computes_the_same_in_eevee(empty_scene, lut_dir, tmp_path):
+    """Identical inputs through the whole world group in both engines, on a smooth environment (a
+    random table would turn Mesa's approximate arccosine, 3.1e-4 relative (docs/conventions.md), into
+    texel-to-texel jumps): EEVEE's half-float film is the only difference allowed."""
+    from engine_parity import eevee_available
+
+    ok, why = eevee_available()
+    if not ok:
+        pytest.skip(why)
+    from conformance import render_group_outputs
+
+    from rt_lookdev.addon import node_emit
+    from rt_lookdev.core.environment import equirect
+    from rt_lookdev.core.lut import exr_io, lookup
+    from rt_lookdev.core.materials import world
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    h, w = 16, 32
+    d = equirect.texel_directions(h, w)                       # top row first
+    levels = [np.stack([1.5 + d[..., 0] * (1.0 - k / 10), 1.2 + 0.5 * d[..., 2], 1.0 + 0.3 * d[..., 1]], -1)
+              for k in range(len(LEVELS))]
+    table = np.concatenate([np.flipud(lv) for lv in levels], 0)
+    table = np.concatenate([table, np.ones(table.shape[:2] + (1,))], -1).astype(np.float32)
+    path = tmp_path / "env_smooth.exr"
+    exr_io.write_table(path, table, {"table": "env_smooth", "roughness_levels": str(list(LEVELS))})
+    env = world.WorldEnvironment.load(path, "env_smooth_eevee")
+    node_emit.register_image(env.name, path)
+    with lookup.use_lut_dir(lut_dir):
+        fn = world.shade_world_function(Features("fdez_aguera", "cod", sheen=True, cloth=True), env)
+        vals = _inputs()
+        vals = {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}
+        ng = node_emit.ensure_function_group(fn, lut_dir)
+        cycles = render_group_outputs(ng, vals, "Radiance")
+        eevee = render_group_outputs(ng, vals, "Radiance", engine="BLENDER_EEVEE")
+    big = (cycles > 1e-3) & (cycles < 65504.0)
+    rel = np.abs(eevee[big] - cycles[big]) / cycles[big]
+    print(f"{fn.name}: {big.sum()} values, EEVEE vs Cycles median {np.median(rel):.2e}, "
+          f"p99 {np.percentile(rel, 99):.2e}, max {rel.max():.2e}")
+    assert big.sum() > 1000 and rel.max() <= 1.5e-3
