@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import bpy
+import numpy as np
 
 from ..core import lights as core_lights
 from ..core.ir import Graph
@@ -133,16 +134,35 @@ def world_environment():
     from ..core.materials.world import WorldEnvironment
 
     ng = bpy.data.node_groups.get(WORLD_GROUP)
-    record = dict(ng["rtl_world"]) if ng is not None and "rtl_world" in ng.keys() else None
+    record = ng["rtl_world"].to_dict() if ng is not None and "rtl_world" in ng.keys() else None
     if not record:
         return None
     try:
         env = WorldEnvironment.load(record["prefiltered"], record["table"])
-    except Exception as exc:  # missing or corrupt cache file: say what to do
-        raise RuntimeError(f"the baked world environment {record['prefiltered']} cannot be read ({exc}); "
-                           "run RT Lookdev > Sync World again") from exc
-    node_emit.register_image(record["table"], record["prefiltered"])
+        node_emit.register_image(record["table"], record["prefiltered"])
+    except Exception as exc:
+        # the cache file is gone (another machine, a cleaned cache): the image packed in this file
+        # holds the same table
+        env = _packed_environment(record)
+        if env is None:
+            raise RuntimeError(f"the baked world environment {record['prefiltered']} cannot be read ({exc}) and "
+                               "is not packed in this file; run RT Lookdev > Sync RT Lit World again") from exc
     return env, record
+
+
+def _packed_environment(record):
+    from ..core.materials.world import WorldEnvironment
+
+    image = bpy.data.images.get(f"RTL_{record['table']}")
+    levels = record.get("roughness_levels")
+    if image is None or not levels:
+        return None
+    w, h = image.size
+    if w * h == 0 or len(image.pixels) != w * h * 4:
+        return None
+    table = np.empty(w * h * 4, np.float32)
+    image.pixels.foreach_get(table)               # bottom row first: the table's row order
+    return WorldEnvironment(record["table"], table.reshape(h, w, 4), tuple(float(r) for r in levels))
 
 
 def _graph_for(features, records, env=None):

@@ -72,7 +72,7 @@ def register_image(table, path):
 
 def _table_path(table, lut_dir):
     if table in catalog.TABLES:
-        return (lut_dir or catalog.default_lut_dir()) / catalog.TABLES[table].filename
+        return Path(lut_dir or catalog.default_lut_dir()) / catalog.TABLES[table].filename
     if table in _EXTRA_IMAGES:
         return _EXTRA_IMAGES[table]
     raise KeyError(f"no image for table {table!r}: not a catalog LUT and not registered (sync the world again)")

@@ -161,4 +161,56 @@ class RTL_OT_add_node_groups(bpy.types.Operator):
         return {'FINISHED'}
 
 
-classes = (RTL_OT_lut_status, RTL_OT_sync_lights, RTL_OT_add_node_groups)
+class RTL_OT_sync_world(bpy.types.Operator):
+    """Bake the World's environment image (cached by its content) and rebuild the RT Lit groups with
+    its light; without a usable image (Background <- Environment Texture [<- Mapping]) the World
+    term is off.  Changing the World's strength or Mapping rotation needs no sync: drivers follow it"""
+
+    bl_idname = "rtl.sync_world"
+    bl_label = "Sync RT Lit World"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        if context.scene is None:
+            cls.poll_message_set("No active scene")
+            return False
+        return True
+
+    def execute(self, context):
+        from . import materials, world
+
+        scene = context.scene
+        lut_dir = preferences.lut_directory(context)
+        wm = context.window_manager
+        show = wm is not None and not bpy.app.background
+
+        def progress(stage, done, total):
+            # SH: the first 5%; the prefiltered levels: the rest
+            fraction = 0.05 * done / total if stage == "sh" else 0.05 + 0.95 * done / max(total, 1)
+            if show:
+                wm.progress_update(100.0 * fraction)
+
+        setup = world.world_setup(scene.world)
+        if show:
+            wm.progress_begin(0, 100)
+        try:
+            bake = world.bake_world(scene, progress=progress) if setup.usable else None
+            record = world.sync_world(scene, bake=bake)
+            groups = materials.rebuild_rt_lit_groups(scene, lut_dir)
+            world.remove_stale_environment_images(keep=record and record["table"])
+        except Exception as ex:
+            self.report({'ERROR'}, f"Could not sync the world: {ex}")
+            return {'CANCELLED'}
+        finally:
+            if show:
+                wm.progress_end()
+        rebuilt = f"{len(groups)} RT Lit groups rebuilt"
+        if record is None:
+            self.report({'WARNING'}, f"RT Lit World term off: {setup.reason}; {rebuilt}")
+        else:
+            self.report({'INFO'}, f"RT Lit World: '{record['image']}' {world.bake_summary(bake)}; {rebuilt}")
+        return {'FINISHED'}
+
+
+classes = (RTL_OT_lut_status, RTL_OT_sync_lights, RTL_OT_sync_world, RTL_OT_add_node_groups)

@@ -1,4 +1,4 @@
-"""The RT Lookdev panel in the material properties."""
+"""The RT Lookdev panels in the material and world properties."""
 from __future__ import annotations
 
 import bpy
@@ -28,8 +28,38 @@ class RTL_PT_material(bpy.types.Panel):
         else:
             col.operator("rtl.convert_to_rt_lit", icon='SHADING_RENDERED')
         layout.operator("rtl.sync_lights", icon='LIGHT_AREA')
+        layout.operator("rtl.sync_world", icon='WORLD')
         layout.operator("rtl.add_node_groups", icon='NODETREE')
         layout.operator("rtl.lut_status", icon='IMAGE_DATA')
 
 
-classes = (RTL_PT_material,)
+class RTL_PT_world(bpy.types.Panel):
+    """The World term of RT Lit: whether the world can be used, and the sync button."""
+    bl_label = "RT Lookdev"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "world"
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None
+
+    def draw(self, context):
+        from . import world
+
+        layout = self.layout
+        setup = world.world_setup(context.scene.world)
+        col = layout.column(align=True)
+        if setup.usable:
+            col.label(text=f"Environment: {setup.image.name}", icon='CHECKMARK')
+            group = bpy.data.node_groups.get(world.WORLD_GROUP)
+            record = group.get(world.RECORD_KEY) if group is not None else None
+            if record is None or record.get("image") != setup.image.name:
+                col.label(text="Not synced: RT Lit shades no World term yet", icon='INFO')
+        else:
+            col.label(text="RT Lit World term off:", icon='INFO')
+            col.label(text=setup.reason)
+        layout.operator("rtl.sync_world", icon='WORLD')
+
+
+classes = (RTL_PT_material, RTL_PT_world)

@@ -1,8 +1,14 @@
 """Build the demo lookdev scene: spheres across roughness, metal, cloth, wrap and sheen, lit by a
-quad (rectangle) and a disk area light, every material converted from Principled to RT Lit.
+quad (rectangle) and a disk area light and a studio HDRI world (rotated by a Mapping node), every
+material converted from Principled to RT Lit.
 
     python scripts/build_demo_scene.py [--out out/demo/lookdev_demo.blend] [--lut-dir DIR]
+                                       [--hdri forest|none] [--world-strength 0.5]
     blender --background --python scripts/build_demo_scene.py -- [same options]
+
+The HDRI is one of those inside Blender (``datafiles/studiolights/world``); its bake is cached
+(addon/world.py).  The world is invisible to Cycles' camera rays and has no importance map (the
+materials are emission only), so the background is black.
 
 The scene is emission-only (the RT Lit materials compute the lighting), so a 1-sample render
 is the material's exact per-pixel value; ``configure_demo_render`` sets that up for Cycles.
@@ -88,16 +94,53 @@ def _light(bpy, name, shape, size, size_y, power, location, rotation, color=(1.0
     return obj
 
 
-def build_demo_scene(lut_dir=None, resolution=256):
-    """Build the scene in the current (emptied) file; returns {sphere name: features}."""
+DEFAULT_HDRI = "forest"
+WORLD_ROTATION_Z = 1.2          # radians, the Mapping node's Z rotation
+
+
+def add_hdri_world(bpy, scene, hdri, strength, rotation_z=WORLD_ROTATION_Z):
+    """World = Background(strength) <- Environment Texture(hdri) <- Mapping(rotation) <- Generated."""
+    from rt_lookdev.core.environment import equirect
+
+    world = bpy.data.worlds.new(f"HDRI {hdri}")
+    scene.world = world
+    nt = world.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputWorld")
+    background = nt.nodes.new("ShaderNodeBackground")
+    background.inputs["Strength"].default_value = strength
+    env = nt.nodes.new("ShaderNodeTexEnvironment")
+    env.image = bpy.data.images.load(str(equirect.resolve_hdri(hdri)), check_existing=True)
+    mapping = nt.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    nt.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    nt.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+    nt.links.new(env.outputs["Color"], background.inputs["Color"])
+    nt.links.new(background.outputs["Background"], out.inputs["Surface"])
+    # The RT Lit materials are emission only: Cycles needs no importance map of the world (building it
+    # cost ~0.8 s per demo render, measured) and the camera should not see it (a black background,
+    # as EEVEE's measurement world: scripts/demo_report.py compares the two).
+    world.cycles.sampling_method = "NONE"
+    world.cycles_visibility.camera = False
+    return world
+
+
+def build_demo_scene(lut_dir=None, resolution=256, hdri=DEFAULT_HDRI, world_strength=0.5):
+    """Build the scene in the current (emptied) file; returns {sphere name: features}.
+    ``hdri=None`` (or "none"): no world, so no World term."""
     import bpy
 
     from rt_lookdev.addon import convert, materials
+    from rt_lookdev.addon import world as rtl_world
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
-    scene.world = None      # no world light yet (issue 6); a new world would add a grey background
+    scene.world = None
+    if hdri and hdri != "none":
+        add_hdri_world(bpy, scene, hdri, world_strength)
+    rtl_world.sync_world(scene)       # no usable image: no "RTL World" group, no World term
 
     # lights first: the RT Lit groups are built for the scene's lights
     _light(bpy, "Quad Key", "RECTANGLE", 2.0, 1.0, 600.0, (-2.0, -3.0, 2.5), (0.9, 0.0, -0.6),
@@ -150,10 +193,12 @@ def main(argv=None):
     parser.add_argument("--out", type=Path, default=DEFAULT_OUT)
     parser.add_argument("--lut-dir", type=Path, default=None)
     parser.add_argument("--resolution", type=int, default=256)
+    parser.add_argument("--hdri", default=DEFAULT_HDRI, help="studio HDRI name or EXR path; 'none' for no world")
+    parser.add_argument("--world-strength", type=float, default=0.5)
     args = parser.parse_args(argv)
     import bpy
 
-    spheres = build_demo_scene(args.lut_dir, args.resolution)
+    spheres = build_demo_scene(args.lut_dir, args.resolution, args.hdri, args.world_strength)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     bpy.ops.wm.save_as_mainfile(filepath=str(args.out.resolve()))
     print(f"demo scene: {len(spheres)} RT Lit spheres, saved to {args.out}")

@@ -2,7 +2,8 @@
 
 - ``scripts/`` goes on sys.path and ``_bootstrap`` loads the repository as ``rt_lookdev``.
 - ``BLENDER_USER_RESOURCES`` points at a throw-away directory before anything can
-  import bpy, so tests never read or write the developer's ~/.config/blender.
+  import bpy, so tests never read or write the developer's ~/.config/blender; baked world
+  environments are cached in out/cache/environments (``RTL_ENVIRONMENT_CACHE``) unless set.
 - ``blender`` marker for tests that need the bpy module; fixtures ``bpy_module``
   (imports bpy once per session: it must never be re-imported) and ``empty_scene``.
 """
@@ -20,6 +21,8 @@ import _bootstrap  # noqa: E402  (loads the package as ``rt_lookdev``)
 
 _USER_RESOURCES = tempfile.TemporaryDirectory(prefix="rtl-blender-user-")
 os.environ["BLENDER_USER_RESOURCES"] = _USER_RESOURCES.name
+# baked world environments (addon/world.py) go to the ignored out/ folder, not to ~/.cache
+os.environ.setdefault("RTL_ENVIRONMENT_CACHE", str(SCRIPTS_DIR.parent / "out" / "cache" / "environments"))
 
 
 def pytest_configure(config):

@@ -308,6 +308,13 @@ class EnvironmentBake:
     prefiltered_path: Path
     states: dict = field(default_factory=dict)      # "sh" / "prefiltered" -> "baked" or "cached"
     seconds: dict = field(default_factory=dict)     # read, sh, prefiltered, total
+    prefiltered_hash: str = ""    # inputs_hash of the prefiltered file (source, parameters, code)
+
+    @property
+    def table_name(self):
+        """Name of the prefiltered table as shading code and Blender images know it: env_<hash>, from
+        the file's inputs hash, so another image, other settings or other code give another name."""
+        return f"env_{self.prefiltered_hash[:12]}"
 
     def world_sh(self, rotation_z=0.0, strength=1.0):
         """Coefficients of the world radiance strength * image(R_z(rotation_z) d)."""
@@ -355,18 +362,37 @@ def _log_progress(stage, done, total):
 def bake_environment(hdri, out_dir, settings=PrefilterSettings(), progress=None, force=False, sh_rule="fejer"):
     """Bake (or find cached) the SH coefficients and the prefiltered levels of one equirect HDRI.
 
-    ``hdri``: a studio HDRI name or an EXR path.  Files in ``out_dir``: ``<name>_sh.exr`` (9 x 1 RGBA,
-    texel i = coefficient i), ``<name>_sh.json`` (the same numbers, readable), and
-    ``<name>_ggx_prefiltered.exr`` (module docstring).  Each file is skipped when it reads back intact
-    and its ``inputs_hash`` (source content hash + parameters + code) matches: a re-run with the same
-    inputs only reads the source and the headers.  ``progress(stage, done, total)``."""
-    progress = progress or _log_progress
+    ``hdri``: a studio HDRI name or an EXR path, read with ``equirect.read_equirect`` and baked by
+    ``bake_environment_image`` under the file's stem (``seconds["read"]`` includes the reading)."""
     t_start = time.perf_counter()
     path = equirect.resolve_hdri(hdri)
-    name = path.stem
     image = equirect.read_equirect(path)
+    read = time.perf_counter() - t_start
+    bake = bake_environment_image(image, path.stem, str(path), out_dir, settings, progress, force, sh_rule)
+    bake.seconds["read"] += read
+    bake.seconds["total"] += read
+    return bake
+
+
+def bake_environment_image(image, name, source, out_dir, settings=PrefilterSettings(), progress=None, force=False,
+                           sh_rule="fejer"):
+    """Bake (or find cached) the SH coefficients and the prefiltered levels of an equirect image.
+
+    ``image``: (H, W, 3) float32, top scanline first (as ``equirect.read_equirect`` returns);
+    ``name``: the file-name stem; ``source``: where the image came from (recorded in the metadata).
+    Files in ``out_dir``: ``<name>_sh.exr`` (9 x 1 RGBA, texel i = coefficient i), ``<name>_sh.json``
+    (the same numbers, readable), and ``<name>_ggx_prefiltered.exr`` (module docstring).  Each file
+    is skipped when it reads back intact and its ``inputs_hash`` (source content hash + parameters +
+    code) matches: a re-run with the same inputs only hashes the image and reads the headers.
+    ``progress(stage, done, total)``."""
+    progress = progress or _log_progress
+    t_start = time.perf_counter()
+    image = np.asarray(image, dtype=np.float32)
+    if image.ndim != 3 or image.shape[2] != 3:
+        raise ValueError(f"expected an (H, W, 3) image, got shape {image.shape}")
+    source = str(source)
     source_hash = equirect.image_hash(image)
-    seconds = {"read": time.perf_counter() - t_start}
+    seconds = {"read": time.perf_counter() - t_start}          # hashing (bake_environment adds the file read)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     states = {}
@@ -388,10 +414,10 @@ def bake_environment(hdri, out_dir, settings=PrefilterSettings(), progress=None,
             "channels": "texel i = coefficient i (order " + sh_params["order"] + "), RGB; A = 1",
             "axis_u": "coefficient index", "axis_v": "none", "layout_version": LAYOUT_VERSION,
             "generator": GENERATOR, "generator_version": GENERATOR_VERSION, "params": json.dumps(sh_params),
-            "inputs_hash": sh_hash, "source": str(path), "source_hash": source_hash})
+            "inputs_hash": sh_hash, "source": source, "source_hash": source_hash})
         coeffs = table[0, :, :3].astype(np.float64)          # the stored (float32) values
         tmp = sh_json.with_name(sh_json.name + ".tmp")
-        tmp.write_text(json.dumps({"source": str(path), "source_hash": source_hash, "order": sh_params["order"],
+        tmp.write_text(json.dumps({"source": source, "source_hash": source_hash, "order": sh_params["order"],
                                    "frame": "image (apply world rotation and strength at use)",
                                    "coefficients_rgb": coeffs.tolist(), "inputs_hash": sh_hash}, indent=1))
         tmp.replace(sh_json)
@@ -420,8 +446,8 @@ def bake_environment(hdri, out_dir, settings=PrefilterSettings(), progress=None,
             "layout_version": LAYOUT_VERSION, "generator": GENERATOR, "generator_version": GENERATOR_VERSION,
             "samples": int(settings.samples), "sampler": "hammersley-2d+ggx-ndf, trilinear mip lookups (Colbert-Krivanek 2007)",
             "params": json.dumps(params, sort_keys=True), "inputs_hash": pf_hash,
-            "source": str(path), "source_hash": source_hash})
+            "source": source, "source_hash": source_hash})
         states["prefiltered"] = "baked"
     seconds["prefiltered"] = time.perf_counter() - t0
     seconds["total"] = time.perf_counter() - t_start
-    return EnvironmentBake(name, str(path), source_hash, coeffs, sh_path, sh_json, pf_path, states, seconds)
+    return EnvironmentBake(name, source, source_hash, coeffs, sh_path, sh_json, pf_path, states, seconds, pf_hash)

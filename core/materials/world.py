@@ -96,8 +96,8 @@ class WorldEnvironment:
 
     @classmethod
     def from_bake(cls, bake):
-        """From a ``core.environment.prefilter.EnvironmentBake``; named env_<source hash[:12]>."""
-        return cls.load(bake.prefiltered_path, f"env_{bake.source_hash[:12]}")
+        """From a ``core.environment.prefilter.EnvironmentBake``, named by its ``table_name``."""
+        return cls.load(bake.prefiltered_path, bake.table_name)
 
     def __post_init__(self):
         levels = np.asarray(self.roughness_levels, np.float64)

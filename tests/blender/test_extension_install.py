@@ -11,7 +11,7 @@ import build_extension
 from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
-OPERATORS = ["add_node_groups", "convert_to_principled", "convert_to_rt_lit", "lut_status", "sync_lights"]
+OPERATORS = ["add_node_groups", "convert_to_principled", "convert_to_rt_lit", "lut_status", "sync_lights", "sync_world"]
 
 pytestmark = pytest.mark.blender
 

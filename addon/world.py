@@ -1,0 +1,470 @@
+"""The scene's World as RT Lit sees it: find its equirect image, bake it, expose it as a node group.
+
+- ``world_setup(world)`` walks the active World Output: Background <- Environment Texture
+  (equirectangular, an image with pixels) [<- Mapping (Point or Vector, rotation only) <- Texture
+  Coordinate > Generated].  Anything else gives a ``reason`` and no World term.
+- ``bake_world(scene)`` reads the image's pixels (``world_image_array``: scene-linear RGB, top row
+  first) and bakes them with ``core.environment.prefilter.bake_environment_image`` into a cache
+  folder (``default_cache_dir``), named by the image's content hash, so a re-sync of an unchanged
+  image only hashes it and reads the cached headers.
+- ``sync_world(scene)`` (re)builds the shared group "RTL World": the 9 baked SH coefficients as
+  static Combine XYZ values, and the Background strength and the Mapping rotation as Value /
+  Combine XYZ nodes driven by simple-expression drivers (SINGLE_PROP on the World), so the strength
+  and rotation stay live without a re-bake and evaluate without Python after a reload.
+
+Measured with bpy 5.0.1 (small Cycles renders; tests/blender/test_world_setup.py checks the rest):
+- ``World.use_nodes`` is deprecated in 5.0 and setting it to False is ignored (the world always
+  renders its nodes); it is checked only before 5.0.
+- An unlinked Mapping Vector input is the constant (0, 0, 0), not the view direction: the world then
+  shows one texel everywhere, so it is refused.  A muted link counts as no link.
+- ``Image.pixels`` of a float image are already scene linear (Blender converts on load, whatever
+  the colour space), and Cycles renders the same values, with negative values shown as 0 and alpha
+  ignored; those of an 8-bit image are the raw bytes / 255 (Cycles applies the colour space at
+  render time): sRGB is decoded here, Non-Color and the working space pass through, other spaces
+  are refused.
+- Drivers inside a node group are evaluated only while something in the view layer uses the group
+  (an RT Lit material on an object); then ``view_layer.update()`` writes the driven values back
+  to the original nodes.
+"""
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from ..core.environment import equirect, prefilter
+from ..core.ir.expr import FLOAT, VECTOR
+from ..core.ir.interface import Socket
+from . import node_emit
+
+WORLD_GROUP = "RTL World"
+RECORD_KEY = "rtl_world"
+CACHE_ENV = "RTL_ENVIRONMENT_CACHE"
+SH_COUNT = 9
+
+#: Output sockets of "RTL World", in order: (name, kind, spec).
+WORLD_OUTPUTS = (
+    *((f"World SH {i}", VECTOR, Socket("vector", (0.0, 0.0, 0.0), description=(
+        f"L2 SH radiance coefficient {i} (R&H 2001 order) of the world image, RGB, image frame, strength 1 "
+        "(baked by RT Lookdev > Sync World)"))) for i in range(SH_COUNT)),
+    ("World Strength", FLOAT, Socket("float", 1.0, description="The World's Background Strength (driver)")),
+    ("World Rotation", VECTOR, Socket("vector", (0.0, 0.0, 0.0), subtype="EULER", description=(
+        "Euler XYZ rotation (radians) of the World's Mapping node (driver; 0 without a Mapping node)"))),
+)
+
+_MAPPING_TYPES = ("POINT", "VECTOR")
+_IMAGE_SOURCES = ("FILE", "GENERATED")
+
+
+# --- the world's setup -------------------------------------------------------------------------------
+
+@dataclass
+class WorldSetup:
+    """What ``world_setup`` found: the image (None when not usable), the Background and Mapping nodes
+    (None when absent), and why the world is not usable ("" when it is)."""
+    image: object = None
+    background: object = None
+    mapping: object = None
+    reason: str = ""
+
+    @property
+    def usable(self):
+        return self.image is not None and not self.reason
+
+
+def _link_into(socket):
+    """The enabled link into an input socket, following reroutes; None when unlinked (a muted or
+    invalid link counts as none, as in Blender's evaluation)."""
+    seen = 0
+    while True:
+        links = [lk for lk in socket.links if lk.is_valid and not lk.is_muted] if socket.is_linked else []
+        if not links:
+            return None
+        link = links[0]
+        node = link.from_node
+        if node.bl_idname != "NodeReroute" or seen > 64:
+            return link
+        seen += 1
+        socket = node.inputs[0]
+
+
+def _describe(node):
+    return f"{node.bl_idname.removeprefix('ShaderNode')} '{node.name}'"
+
+
+def _uses_nodes(world):
+    if bpy.app.version >= (5, 0, 0):
+        return True          # deprecated in 5.0, always True (setting False is ignored)
+    return bool(world.use_nodes)
+
+
+def working_space():
+    """The scene-linear working colour space of the file ("Linear Rec.709" before Blender 5.0)."""
+    colorspace = getattr(bpy.data, "colorspace", None)
+    return getattr(colorspace, "working_space", None) or "Linear Rec.709"
+
+
+def _byte_decoding(image):
+    """How the raw bytes of an 8-bit image become scene linear: "raw", "srgb", or None (unsupported)."""
+    settings = image.colorspace_settings
+    name = settings.name
+    if settings.is_data or name in ("Non-Color", "scene_linear", working_space()):
+        return "raw"
+    if name == "sRGB" and working_space() == "Linear Rec.709":
+        return "srgb"
+    return None
+
+
+def _image_reason(image):
+    """Why ``image`` cannot be baked ("" when it can)."""
+    if image.source not in _IMAGE_SOURCES:
+        return f"the Environment Texture's image '{image.name}' is a {image.source.lower()} image (a single image is needed)"
+    width, height = image.size
+    if width <= 0 or height <= 0:
+        return f"the Environment Texture's image '{image.name}' has no pixels (missing file?)"
+    if not image.is_float and _byte_decoding(image) is None:
+        return (f"the 8-bit image '{image.name}' is in colour space {image.colorspace_settings.name!r}: RT Lit reads "
+                f"8-bit images in sRGB, Non-Color or {working_space()} (or use a float image)")
+    return ""
+
+
+def _mapping_reason(mapping):
+    """Why a Mapping node in front of the Environment Texture is unsupported ("" when supported)."""
+    what = f"unsupported Mapping node '{mapping.name}'"
+    if mapping.mute:
+        return f"{what}: it is muted"
+    if mapping.vector_type not in _MAPPING_TYPES:
+        return f"{what}: type {mapping.vector_type} (Point or Vector only)"
+    checked = ("Rotation", "Scale") if mapping.vector_type == "VECTOR" else ("Location", "Rotation", "Scale")
+    for name in checked:
+        if _link_into(mapping.inputs[name]) is not None:
+            return f"{what}: its {name} input is linked (rotation values only)"
+    if mapping.vector_type == "POINT" and any(abs(v) > 1e-6 for v in mapping.inputs["Location"].default_value):
+        return f"{what}: Location is not 0 (rotation only)"
+    if any(abs(v - 1.0) > 1e-6 for v in mapping.inputs["Scale"].default_value):
+        return f"{what}: Scale is not 1 (rotation only)"
+    link = _link_into(mapping.inputs["Vector"])
+    if link is None:
+        return (f"{what}: its Vector input is unlinked, so the world shows one fixed direction "
+                "(link Texture Coordinate > Generated into it)")
+    reason = _coordinates_reason(link, "the Mapping node's Vector")
+    return f"{what}: {reason}" if reason else ""
+
+
+def _coordinates_reason(link, into):
+    if link.from_node.bl_idname != "ShaderNodeTexCoord" or link.from_socket.identifier != "Generated":
+        return f"{into} comes from {_describe(link.from_node)} > {link.from_socket.name}, not Texture Coordinate > Generated"
+    if link.from_node.mute:
+        return f"{into} comes from a muted Texture Coordinate node"
+    return ""
+
+
+def world_setup(world):
+    """The ``WorldSetup`` of ``world`` (a bpy World or None).  Usable: the active World Output's Surface
+    comes from a Background node whose Color comes directly from an equirectangular Environment
+    Texture with an image that has pixels; that texture's Vector is unlinked, Texture Coordinate >
+    Generated, or a Mapping node (Point or Vector, rotation only) fed by Texture Coordinate > Generated."""
+    if world is None:
+        return WorldSetup(reason="the scene has no World")
+    if not _uses_nodes(world) or world.node_tree is None:
+        return WorldSetup(reason=f"World '{world.name}' does not use nodes")
+    tree = world.node_tree
+    output = tree.get_output_node("CYCLES")
+    if output is None:
+        return WorldSetup(reason=f"World '{world.name}' has no active World Output node")
+    link = _link_into(output.inputs["Surface"])
+    if link is None:
+        return WorldSetup(reason=f"the World Output of '{world.name}' has nothing linked to its Surface")
+    background = link.from_node
+    if background.bl_idname != "ShaderNodeBackground":
+        return WorldSetup(reason=f"the World Output's Surface comes from {_describe(background)}, not a Background node")
+    setup = WorldSetup(background=background)
+    if background.mute:
+        setup.reason = f"the Background node '{background.name}' is muted"
+        return setup
+    if _link_into(background.inputs["Strength"]) is not None:
+        setup.reason = "the Background node's Strength is linked (a value is needed)"
+        return setup
+    link = _link_into(background.inputs["Color"])
+    if link is None:
+        setup.reason = "the Background has a plain colour, no Environment Texture"
+        return setup
+    env = link.from_node
+    if env.bl_idname != "ShaderNodeTexEnvironment":
+        setup.reason = f"the Background's Color comes from {_describe(env)}, not an Environment Texture"
+        return setup
+    if link.from_socket.identifier != "Color":
+        setup.reason = f"the Background's Color comes from the Environment Texture's {link.from_socket.name} output"
+        return setup
+    if env.mute:
+        setup.reason = f"the Environment Texture '{env.name}' is muted"
+        return setup
+    if env.projection != "EQUIRECTANGULAR":
+        setup.reason = f"the Environment Texture uses {env.projection.replace('_', ' ').lower()} projection (equirectangular only)"
+        return setup
+    if env.image is None:
+        setup.reason = "the Environment Texture has no image"
+        return setup
+    link = _link_into(env.inputs["Vector"])
+    if link is not None:
+        if link.from_node.bl_idname == "ShaderNodeMapping":
+            setup.mapping = link.from_node
+            setup.reason = _mapping_reason(setup.mapping)
+        else:
+            setup.reason = _coordinates_reason(link, "the Environment Texture's Vector")
+            if setup.reason:
+                setup.reason += " (a Mapping node with rotation only is supported)"
+        if setup.reason:
+            return setup
+    setup.reason = _image_reason(env.image)
+    if not setup.reason:
+        setup.image = env.image
+    return setup
+
+
+# --- pixels and baking --------------------------------------------------------------------------------
+
+def _srgb_to_linear(x):
+    """The sRGB decoding (IEC 61966-2-1), equal to Blender's sRGB -> Linear Rec.709 to 4e-7."""
+    return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def world_image_array(image):
+    """(H, W, 3) float32 scene-linear RGB of ``image``, top scanline first (``equirect`` orientation);
+    alpha dropped, non-finite and negative values set to 0 (Cycles shows negative radiance as 0)."""
+    width, height = image.size
+    channels = image.channels
+    buf = np.empty(width * height * channels, dtype=np.float32)
+    image.pixels.foreach_get(buf)
+    pix = buf.reshape(height, width, channels)
+    if channels >= 3:
+        rgb = pix[::-1, :, :3]
+    else:
+        rgb = np.repeat(pix[::-1, :, :1], 3, axis=2)
+    rgb = np.ascontiguousarray(rgb, dtype=np.float32)
+    if not image.is_float and _byte_decoding(image) == "srgb":
+        rgb = _srgb_to_linear(rgb)
+    rgb = np.nan_to_num(rgb, nan=0.0, posinf=0.0, neginf=0.0)
+    np.maximum(rgb, 0.0, out=rgb)
+    return rgb
+
+
+def default_cache_dir():
+    """The bake cache: ``$RTL_ENVIRONMENT_CACHE``, else ``$XDG_CACHE_HOME/rt_lookdev/environments``
+    (``~/.cache`` when XDG_CACHE_HOME is unset); created here."""
+    env = os.environ.get(CACHE_ENV)
+    if env:
+        path = Path(env).expanduser()
+    else:
+        base = os.environ.get("XDG_CACHE_HOME")
+        base = Path(base).expanduser() if base else Path.home() / ".cache"
+        path = base / "rt_lookdev" / "environments"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def _file_stem(image):
+    stem = Path(image.name).stem if "." in image.name else image.name
+    stem = re.sub(r"[^A-Za-z0-9_-]+", "_", stem).strip("_")[:48]
+    return stem or "world"
+
+
+def _image_source(image):
+    if image.packed_file is not None:
+        return f"packed:{image.name}"
+    if image.source == "GENERATED" or not image.filepath:
+        return f"generated:{image.name}"
+    return bpy.path.abspath(image.filepath, library=image.library)
+
+
+def bake_world(scene, cache_dir=None, progress=None, force=False, settings=None):
+    """Bake (or find cached) the environment of ``scene``'s World: an ``EnvironmentBake``, or None when
+    the world has no usable image (``world_setup`` says why).  Files ``<image>_<hash12>_*`` in
+    ``cache_dir`` (default ``default_cache_dir()``); ``progress(stage, done, total)`` as in core;
+    ``settings``: ``PrefilterSettings`` (default: the measured defaults)."""
+    setup = world_setup(scene.world)
+    if not setup.usable:
+        return None
+    image = setup.image
+    array = world_image_array(image)
+    name = f"{_file_stem(image)}_{equirect.image_hash(array)[:12]}"
+    out_dir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
+    return prefilter.bake_environment_image(array, name, _image_source(image), out_dir,
+                                            settings or prefilter.PrefilterSettings(), progress, force)
+
+
+# --- the "RTL World" group ----------------------------------------------------------------------------
+
+def remove_world_group():
+    """Remove "RTL World" if present; True when one was removed."""
+    ng = bpy.data.node_groups.get(WORLD_GROUP)
+    if ng is None:
+        return False
+    bpy.data.node_groups.remove(ng)
+    return True
+
+
+def _input_path(node, socket):
+    index = list(node.inputs).index(socket)
+    return f'node_tree.nodes["{bpy.utils.escape_identifier(node.name)}"].inputs[{index}].default_value'
+
+
+def _drive(socket, world, data_path):
+    """A simple-expression driver ``var`` on socket.default_value reading ``world``'s ``data_path``."""
+    fc = socket.driver_add("default_value")
+    drv = fc.driver
+    drv.type = "SCRIPTED"
+    drv.expression = "var"
+    var = drv.variables.new()
+    var.name = "var"
+    var.type = "SINGLE_PROP"
+    target = var.targets[0]
+    target.id_type = "WORLD"
+    target.id = world
+    target.data_path = data_path
+    return fc
+
+
+def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
+    """(Re)build "RTL World" for ``scene``'s World and return its record ({"table", "prefiltered", "sh",
+    "source_hash", "image"}); when the world has no usable image, remove the group and return None.
+
+    ``bake``: an ``EnvironmentBake`` of this world already made by ``bake_world`` (else it is made here
+    with ``cache_dir``, ``progress``, ``settings``).  The group's interface is kept when unchanged, so
+    RT Lit groups using it keep their links."""
+    world = scene.world
+    setup = world_setup(world)
+    if not setup.usable:
+        remove_world_group()
+        return None
+    if bake is None:
+        bake = bake_world(scene, cache_dir, progress, settings=settings)
+    ng = bpy.data.node_groups.get(WORLD_GROUP)
+    if ng is None or ng.bl_idname != "ShaderNodeTree":
+        ng = bpy.data.node_groups.new(WORLD_GROUP, "ShaderNodeTree")
+    if ng.animation_data is not None:
+        for fc in list(ng.animation_data.drivers):
+            ng.animation_data.drivers.remove(fc)
+    ng.nodes.clear()
+    ng.description = ("The World's environment for RT Lit: baked SH coefficients and driven strength and rotation "
+                      "(rebuilt by RT Lookdev > Sync World)")
+    items = node_emit._ensure_interface(ng, [(name, "OUTPUT", kind, spec) for name, kind, spec in WORLD_OUTPUTS])
+    out = ng.nodes.new("NodeGroupOutput")
+    out.location = (400.0, 0.0)
+
+    def output(name):
+        return node_emit._socket(out.inputs, items[(name, "OUTPUT")].identifier)
+
+    def combine(name, values, row):
+        node = ng.nodes.new("ShaderNodeCombineXYZ")
+        node.name = node.label = name
+        node.location = (0.0, -row * 140.0)
+        for sock, value in zip(node.inputs, values):
+            sock.default_value = float(value)
+        ng.links.new(node.outputs[0], output(f"World {name}"))
+        return node
+
+    for i in range(SH_COUNT):
+        combine(f"SH {i}", bake.sh_image[i], i)
+
+    background = setup.background
+    strength_socket = background.inputs["Strength"]
+    value = ng.nodes.new("ShaderNodeValue")
+    value.name = value.label = "Strength"
+    value.location = (0.0, -SH_COUNT * 140.0)
+    value.outputs[0].default_value = float(strength_socket.default_value)
+    _drive(value.outputs[0], world, _input_path(background, strength_socket))
+    ng.links.new(value.outputs[0], output("World Strength"))
+
+    mapping = setup.mapping
+    rotation = combine("Rotation", _rotation(setup), SH_COUNT + 1)
+    if mapping is not None:
+        path = _input_path(mapping, mapping.inputs["Rotation"])
+        for axis in range(3):
+            _drive(rotation.inputs[axis], world, f"{path}[{axis}]")
+
+    record = {"table": bake.table_name, "prefiltered": str(bake.prefiltered_path),
+              "sh": str(bake.sh_path), "source_hash": bake.source_hash, "image": setup.image.name,
+              "roughness_levels": _roughness_levels(bake)}
+    ng[RECORD_KEY] = record
+    node_emit.register_image(record["table"], bake.prefiltered_path)
+    return record
+
+
+def remove_stale_environment_images(keep=None):
+    """Remove the node groups and packed prefiltered images of earlier bakes (named after a table
+    ``env_*`` other than ``keep``) that nothing uses any more: the images carry a fake user, so they
+    would otherwise stay in the .blend forever.
+    Call it after the RT Lit groups were rebuilt (``materials.rebuild_rt_lit_groups``)."""
+    removed = []
+    # the groups of earlier bakes first ("RTL Shade World (...; env_<old>)" uses "RTL Environment
+    # env_<old>", which uses the image): unused ones go, repeatedly, innermost last
+    changed = True
+    while changed:
+        changed = False
+        for ng in list(bpy.data.node_groups):
+            name = ng.name
+            if name.startswith("RTL ") and "env_" in name and not (keep and keep in name) and ng.users == 0:
+                removed.append(name)
+                bpy.data.node_groups.remove(ng)
+                changed = True
+    for image in list(bpy.data.images):
+        if not image.name.startswith("RTL_env_") or image.name == f"RTL_{keep}":
+            continue
+        if image.users - int(image.use_fake_user) == 0:
+            removed.append(image.name)
+            bpy.data.images.remove(image)
+    return removed
+
+
+def _roughness_levels(bake):
+    """The roughness of each prefiltered level, from the file's metadata (recorded so the packed image
+    alone can serve when the cache file is gone: addon/materials.py)."""
+    import json
+
+    from ..core.lut import exr_io
+
+    _, meta = exr_io.read_table(bake.prefiltered_path)
+    return [float(r) for r in json.loads(meta["roughness_levels"])]
+
+
+def _rotation(setup):
+    if setup.mapping is None:
+        return (0.0, 0.0, 0.0)
+    return tuple(float(v) for v in setup.mapping.inputs["Rotation"].default_value)
+
+
+def world_parameters(scene, cache_dir=None, settings=None):
+    """The values "RTL World" delivers, read from the current world (not from drivers): {"SH 0" ...
+    "SH 8": (3,) arrays, "Strength": float, "Rotation": (3,) array}; None when the world is not usable.
+    The SH coefficients are those of the synced group (its static values) when it exists, else the
+    (cached) bake of the current image."""
+    setup = world_setup(scene.world)
+    if not setup.usable:
+        return None
+    ng = bpy.data.node_groups.get(WORLD_GROUP)
+    if ng is not None and all(f"SH {i}" in ng.nodes for i in range(SH_COUNT)):
+        sh = np.array([[float(s.default_value) for s in ng.nodes[f"SH {i}"].inputs[:3]] for i in range(SH_COUNT)])
+    else:
+        sh = bake_world(scene, cache_dir, settings=settings).sh_image
+    params = {f"SH {i}": np.asarray(sh[i], dtype=np.float64) for i in range(SH_COUNT)}
+    params["Strength"] = float(setup.background.inputs["Strength"].default_value)
+    params["Rotation"] = np.array(_rotation(setup), dtype=np.float64)
+    return params
+
+
+def bake_summary(bake):
+    """One line: "baked in 3.2 s (sh baked, prefiltered baked)" / "cached (0.02 s)"."""
+    states = bake.states
+    seconds = bake.seconds.get("total", 0.0)
+    if all(s == "cached" for s in states.values()):
+        return f"cached ({seconds:.2f} s)"
+    return f"baked in {seconds:.1f} s (" + ", ".join(f"{k} {v}" for k, v in states.items()) + ")"
+
+
+__all__ = ["WORLD_GROUP", "WorldSetup", "world_setup", "world_image_array", "default_cache_dir", "bake_world",
+           "sync_world", "world_parameters", "remove_world_group", "bake_summary"]

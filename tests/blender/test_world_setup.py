@@ -1,0 +1,460 @@
+"""addon/world.py: which worlds RT Lit can use, their pixels, the cached bake, the "RTL World" group
+and its drivers, and the Sync World operator (in-process bpy, small synthetic images)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("OpenEXR")
+
+pytestmark = pytest.mark.blender
+
+H, W = 32, 64
+
+
+@pytest.fixture
+def world_mod(bpy_module, empty_scene, tmp_path, monkeypatch):
+    from rt_lookdev.addon import world
+
+    monkeypatch.setenv(world.CACHE_ENV, str(tmp_path / "env-cache"))
+    yield world
+    world.remove_world_group()
+
+
+@pytest.fixture
+def small():
+    from rt_lookdev.core.environment.prefilter import PrefilterSettings
+
+    return PrefilterSettings(16, 8, (0.0, 0.5, 1.0))
+
+
+def _environment(seed=3):
+    """(H, W, 3) top row first: smooth random radiance with a bright band in the top 4 rows."""
+    rng = np.random.default_rng(seed)
+    img = rng.uniform(0.1, 1.0, size=(H, W, 3)).astype(np.float32)
+    img[:4] = (8.0, 6.0, 4.0)
+    return img
+
+
+def _image(bpy, name, top_first, float_buffer=True):
+    """A generated image holding ``top_first`` (H, W, 3): bpy pixels are bottom row first, RGBA."""
+    h, w = top_first.shape[:2]
+    img = bpy.data.images.new(name, w, h, alpha=True, float_buffer=float_buffer)
+    rgba = np.ones((h, w, 4), np.float32)
+    rgba[..., :3] = top_first
+    img.pixels.foreach_set(rgba[::-1].ravel())
+    return img
+
+
+def _world(bpy, scene, image=None, mapping=None, coords=True):
+    """Background <- Environment Texture (``image``) [<- Mapping (type ``mapping``) <- Generated]."""
+    world = bpy.data.worlds.new("World")
+    scene.world = world
+    nt = world.node_tree
+    bg = nt.nodes["Background"]
+    env = nt.nodes.new("ShaderNodeTexEnvironment")
+    env.image = image
+    nt.links.new(env.outputs["Color"], bg.inputs["Color"])
+    if mapping is not None:
+        m = nt.nodes.new("ShaderNodeMapping")
+        m.name = 'Mapping "rot"'           # a name that needs escaping in driver paths
+        m.vector_type = mapping
+        nt.links.new(m.outputs["Vector"], env.inputs["Vector"])
+        if coords:
+            tc = nt.nodes.new("ShaderNodeTexCoord")
+            nt.links.new(tc.outputs["Generated"], m.inputs["Vector"])
+    return world
+
+
+def test_world_setup_reasons(bpy_module, world_mod):
+    bpy = bpy_module
+    scene = bpy.context.scene
+    setup = world_mod.world_setup(scene.world)
+    assert not setup.usable and "no World" in setup.reason
+
+    image = _image(bpy, "env.exr", _environment())
+    world = _world(bpy, scene, image)
+    nt = world.node_tree
+    bg, env = nt.nodes["Background"], nt.nodes["Environment Texture"]
+    setup = world_mod.world_setup(world)
+    assert setup.usable and setup.reason == "" and setup.image == image
+    assert setup.background == bg and setup.mapping is None
+
+    # Blender 5.0 deprecates World.use_nodes and ignores False (the world renders its nodes)
+    if bpy.app.version >= (5, 0, 0):
+        with pytest.warns(DeprecationWarning):
+            world.use_nodes = False
+        assert world_mod.world_setup(world).usable
+    else:
+        world.use_nodes = False
+        assert "does not use nodes" in world_mod.world_setup(world).reason
+        world.use_nodes = True
+
+    # Texture Coordinate > Generated straight into the texture, and through a reroute: the same
+    tc = nt.nodes.new("ShaderNodeTexCoord")
+    reroute = nt.nodes.new("NodeReroute")
+    nt.links.new(tc.outputs["Generated"], reroute.inputs[0])
+    nt.links.new(reroute.outputs[0], env.inputs["Vector"])
+    assert world_mod.world_setup(world).usable
+    nt.links.new(tc.outputs["Object"], env.inputs["Vector"])
+    assert "Texture Coordinate > Generated" in world_mod.world_setup(world).reason
+    nt.links.remove(env.inputs["Vector"].links[0])
+
+    env.projection = "MIRROR_BALL"
+    assert "projection" in world_mod.world_setup(world).reason
+    env.projection = "EQUIRECTANGULAR"
+    link = bg.inputs["Color"].links[0]
+    link.is_muted = True                     # a muted link is no link: a plain colour
+    assert "plain colour" in world_mod.world_setup(world).reason
+    nt.links.remove(link)
+    assert "plain colour" in world_mod.world_setup(world).reason
+    nt.links.new(env.outputs["Color"], bg.inputs["Color"])
+
+    env.image = None
+    setup = world_mod.world_setup(world)
+    assert not setup.usable and setup.image is None and "no image" in setup.reason
+    missing = bpy.data.images.new("missing", 4, 4)
+    missing.source = "FILE"
+    missing.filepath = "/nonexistent/rtl_missing.exr"
+    env.image = missing
+    assert "no pixels" in world_mod.world_setup(world).reason
+    byte = _image(bpy, "byte", _environment()[:, :, :] / 8.0, float_buffer=False)
+    env.image = byte
+    assert world_mod.world_setup(world).usable             # 8-bit sRGB: decoded
+    byte.colorspace_settings.name = "Linear Rec.2020"
+    assert "colour space" in world_mod.world_setup(world).reason
+    env.image = image
+
+    emission = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(emission.outputs[0], nt.nodes["World Output"].inputs["Surface"])
+    assert "not a Background" in world_mod.world_setup(world).reason
+    nt.links.new(bg.outputs[0], nt.nodes["World Output"].inputs["Surface"])
+    value = nt.nodes.new("ShaderNodeValue")
+    nt.links.new(value.outputs[0], bg.inputs["Strength"])
+    assert "Strength is linked" in world_mod.world_setup(world).reason
+    nt.links.remove(bg.inputs["Strength"].links[0])
+    assert world_mod.world_setup(world).usable
+
+
+@pytest.mark.parametrize("vector_type", ["POINT", "VECTOR"])
+def test_world_setup_mapping(bpy_module, world_mod, vector_type):
+    bpy = bpy_module
+    scene = bpy.context.scene
+    world = _world(bpy, scene, _image(bpy, "env", _environment()), mapping=vector_type)
+    m = world.node_tree.nodes['Mapping "rot"']
+    m.inputs["Rotation"].default_value = (0.1, -0.2, 0.3)
+    setup = world_mod.world_setup(world)
+    assert setup.usable and setup.mapping == m
+
+    def reason():
+        r = world_mod.world_setup(world).reason
+        assert r.startswith("unsupported Mapping"), r
+        return r
+
+    m.inputs["Scale"].default_value = (2.0, 1.0, 1.0)
+    assert "Scale" in reason()
+    m.inputs["Scale"].default_value = (1.0, 1.0, 1.0)
+    location = m.inputs[1]                    # by name only while available (Point): 5.0 hides it for Vector
+    location.default_value = (0.0, 0.5, 0.0)
+    if vector_type == "POINT":
+        assert "Location" in reason()
+    else:                                     # a Vector mapping ignores Location
+        assert world_mod.world_setup(world).usable
+    location.default_value = (0.0, 0.0, 0.0)
+    value = world.node_tree.nodes.new("ShaderNodeCombineXYZ")
+    link = world.node_tree.links.new(value.outputs[0], m.inputs["Rotation"])
+    assert "Rotation input is linked" in reason()
+    world.node_tree.links.remove(link)
+    m.vector_type = "TEXTURE"
+    assert "TEXTURE" in reason()
+    m.vector_type = vector_type
+    world.node_tree.links.remove(m.inputs["Vector"].links[0])
+    # Measured: an unlinked Mapping Vector is the constant (0, 0, 0), not the view direction
+    assert "Vector input is unlinked" in reason()
+
+
+def test_world_image_array_orientation_and_cleaning(bpy_module, world_mod):
+    bpy = bpy_module
+    import mathutils
+
+    src = _environment()
+    src[10, 5] = (np.nan, np.inf, -np.inf)
+    src[11, 6] = (-0.5, 0.25, 0.0)
+    arr = world_mod.world_image_array(_image(bpy, "env", src))
+    assert arr.shape == (H, W, 3) and arr.dtype == np.float32
+    # row 0 is the top scanline (+Z): the bright band
+    np.testing.assert_array_equal(arr[:4], np.broadcast_to(np.float32([8.0, 6.0, 4.0]), (4, W, 3)))
+    np.testing.assert_array_equal(arr[10, 5], 0.0)
+    np.testing.assert_array_equal(arr[11, 6], [0.0, 0.25, 0.0])
+    clean = src.copy()
+    clean[10, 5] = 0.0
+    clean[11, 6, 0] = 0.0
+    np.testing.assert_array_equal(arr, clean)
+
+    # 8-bit sRGB: bytes / 255 decoded as Blender decodes sRGB
+    ramp = np.tile(np.linspace(0.0, 1.0, W, dtype=np.float32)[None, :, None], (H, 1, 3))
+    byte = _image(bpy, "byte", ramp, float_buffer=False)
+    raw = np.empty(W * H * 4, np.float32)
+    byte.pixels.foreach_get(raw)
+    raw = raw.reshape(H, W, 4)[::-1, :, :3]
+    got = world_mod.world_image_array(byte)
+    assert np.all(got[0] == got[-1]) and got[0, -1, 0] == pytest.approx(1.0)
+    lut = [mathutils.Color((v, v, v)).from_srgb_to_scene_linear()[0] for v in raw[0, :, 0]]
+    np.testing.assert_allclose(got[0, :, 0], lut, atol=1e-6)
+    byte.colorspace_settings.name = "Non-Color"          # regenerates a generated image: set the bytes again
+    rgba = np.ones((H, W, 4), np.float32)
+    rgba[..., :3] = raw
+    byte.pixels.foreach_set(rgba[::-1].ravel())
+    np.testing.assert_array_equal(world_mod.world_image_array(byte), raw)
+
+
+def test_bake_world_is_cached_by_content(bpy_module, world_mod, small, tmp_path, monkeypatch):
+    bpy = bpy_module
+    from rt_lookdev.core.environment import equirect, prefilter, sh
+
+    scene = bpy.context.scene
+    assert world_mod.bake_world(scene, tmp_path, settings=small) is None       # no world
+    image = _image(bpy, "My Env.exr", _environment())
+    _world(bpy, scene, image)
+    calls = []
+    first = world_mod.bake_world(scene, tmp_path, progress=lambda *a: calls.append(a), settings=small)
+    assert first.states == {"sh": "baked", "prefiltered": "baked"}
+    assert calls[-1] == ("prefiltered", 3, 3)
+    array = world_mod.world_image_array(image)
+    assert first.source_hash == equirect.image_hash(array)
+    assert first.name == f"My_Env_{first.source_hash[:12]}" and first.source == "generated:My Env.exr"
+    assert first.prefiltered_path.parent == tmp_path and first.prefiltered_path.name.startswith(first.name)
+    np.testing.assert_allclose(first.sh_image, sh.sh_project(array), rtol=1e-6, atol=1e-7)
+    levels, rl, _ = prefilter.read_prefiltered(first.prefiltered_path)
+    assert levels.shape == (3, 8, 16, 3) and rl == [0.0, 0.5, 1.0]
+
+    def boom(*a, **k):
+        raise AssertionError("a cached re-run must not compute")
+    with monkeypatch.context() as mp:
+        mp.setattr(prefilter, "prefilter", boom)
+        mp.setattr(sh, "sh_project", boom)
+        again = world_mod.bake_world(scene, tmp_path, settings=small)
+    assert again.states == {"sh": "cached", "prefiltered": "cached"}
+    np.testing.assert_array_equal(again.sh_image, first.sh_image)
+
+    # same name, other content: other files, the first bake's files stay
+    other = _environment(seed=4)
+    image.pixels.foreach_set(np.concatenate([other, np.ones((H, W, 1), np.float32)], -1)[::-1].ravel())
+    second = world_mod.bake_world(scene, tmp_path, settings=small)
+    assert second.states == {"sh": "baked", "prefiltered": "baked"}
+    assert second.source_hash != first.source_hash and second.prefiltered_path != first.prefiltered_path
+    assert first.prefiltered_path.is_file() and first.sh_path.is_file()
+    assert prefilter.read_sh(first.sh_path)[1]["source_hash"] == first.source_hash
+
+    # default folder: $RTL_ENVIRONMENT_CACHE
+    assert world_mod.default_cache_dir() == tmp_path / "env-cache"
+    assert world_mod.default_cache_dir().is_dir()
+    monkeypatch.delenv(world_mod.CACHE_ENV)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert world_mod.default_cache_dir() == tmp_path / "xdg" / "rt_lookdev" / "environments"
+
+
+def _use_group(bpy, scene, group):
+    """An object whose material instances ``group`` (drivers inside a group evaluate only while the
+    view layer uses it) and links two of its outputs."""
+    mat = bpy.data.materials.new("uses RTL World")
+    nt = mat.node_tree
+    node = nt.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    emission = nt.nodes.new("ShaderNodeEmission")
+    nt.links.new(node.outputs["World Strength"], emission.inputs["Strength"])
+    nt.links.new(node.outputs["World SH 0"], emission.inputs["Color"])
+    obj = bpy.data.objects.new("user", bpy.data.meshes.new("user"))
+    obj.data.materials.append(mat)
+    scene.collection.objects.link(obj)
+    return mat, node
+
+
+def test_sync_world_group_and_drivers(bpy_module, world_mod, small, tmp_path):
+    bpy = bpy_module
+    from rt_lookdev.addon import node_emit
+
+    scene = bpy.context.scene
+    world = _world(bpy, scene, _image(bpy, "env", _environment()), mapping="POINT")
+    bg = world.node_tree.nodes["Background"]
+    m = world.node_tree.nodes['Mapping "rot"']
+    bg.inputs["Strength"].default_value = 1.5
+    m.inputs["Rotation"].default_value = (0.1, -0.2, 0.3)
+
+    record = world_mod.sync_world(scene, tmp_path, settings=small)
+    bake = world_mod.bake_world(scene, tmp_path, settings=small)
+    assert bake.states == {"sh": "cached", "prefiltered": "cached"}
+    assert record == {"table": bake.table_name, "prefiltered": str(bake.prefiltered_path),
+                      "sh": str(bake.sh_path), "source_hash": bake.source_hash, "image": "env",
+                      "roughness_levels": [0.0, 0.5, 1.0]}
+    ng = bpy.data.node_groups[world_mod.WORLD_GROUP]
+    assert ng["rtl_world"].to_dict() == record
+    assert record["table"] == f"env_{bake.prefiltered_hash[:12]}"
+    assert node_emit._table_path(record["table"], None) == bake.prefiltered_path
+
+    outputs = [(it.name, it.socket_type) for it in ng.interface.items_tree if it.item_type == "SOCKET"]
+    assert outputs == ([(f"World SH {i}", "NodeSocketVector") for i in range(9)]
+                       + [("World Strength", "NodeSocketFloat"), ("World Rotation", "NodeSocketVector")])
+    assert all(it.in_out == "OUTPUT" for it in ng.interface.items_tree if it.item_type == "SOCKET")
+    out = next(n for n in ng.nodes if n.bl_idname == "NodeGroupOutput")
+    for i in range(9):
+        node = out.inputs[f"World SH {i}"].links[0].from_node
+        assert node.bl_idname == "ShaderNodeCombineXYZ"
+        np.testing.assert_array_equal([s.default_value for s in node.inputs[:3]], bake.sh_image[i].astype(np.float32))
+    strength = out.inputs["World Strength"].links[0].from_node
+    rotation = out.inputs["World Rotation"].links[0].from_node
+    assert strength.bl_idname == "ShaderNodeValue" and strength.outputs[0].default_value == 1.5
+    np.testing.assert_allclose([s.default_value for s in rotation.inputs[:3]], (0.1, -0.2, 0.3), rtol=1e-6)
+    drivers = {fc.data_path: fc.driver for fc in ng.animation_data.drivers}
+    assert len(drivers) == 4
+    assert all(d.is_valid and d.is_simple_expression and d.variables[0].targets[0].id == world
+               for d in drivers.values())
+    assert drivers['nodes["Strength"].outputs[0].default_value'].variables[0].targets[0].data_path == \
+        'node_tree.nodes["Background"].inputs[1].default_value'
+    assert drivers['nodes["Rotation"].inputs[2].default_value'].variables[0].targets[0].data_path == \
+        'node_tree.nodes["Mapping \\"rot\\""].inputs[2].default_value[2]'
+
+    params = world_mod.world_parameters(scene)
+    assert params["Strength"] == 1.5
+    np.testing.assert_allclose(params["Rotation"], (0.1, -0.2, 0.3), rtol=1e-6)
+    for i in range(9):
+        np.testing.assert_allclose(params[f"SH {i}"], bake.sh_image[i], rtol=1e-6)
+
+    # drivers follow the world (once the view layer uses the group)
+    mat, user = _use_group(bpy, scene, ng)
+    bg.inputs["Strength"].default_value = 2.25
+    m.inputs["Rotation"].default_value[2] = -0.7
+    bpy.context.view_layer.update()
+    assert strength.outputs[0].default_value == 2.25
+    assert rotation.inputs[2].default_value == pytest.approx(-0.7)
+    assert world_mod.world_parameters(scene)["Strength"] == 2.25
+
+    # a re-sync rebuilds in place: same group, interface and the users' links kept
+    pointer = ng.as_pointer()
+    assert world_mod.sync_world(scene, tmp_path, settings=small) == record
+    ng = bpy.data.node_groups[world_mod.WORLD_GROUP]
+    assert ng.as_pointer() == pointer and user.node_tree == ng
+    assert user.outputs["World Strength"].is_linked and user.outputs["World SH 0"].is_linked
+    assert len(ng.animation_data.drivers) == 4
+    assert len([n for n in ng.nodes if n.bl_idname == "ShaderNodeValue"]) == 1
+
+    # no Mapping: rotation is a static 0, no rotation drivers
+    world.node_tree.links.remove(world.node_tree.nodes["Environment Texture"].inputs["Vector"].links[0])
+    world_mod.sync_world(scene, tmp_path, settings=small)
+    assert [fc.data_path for fc in ng.animation_data.drivers] == ['nodes["Strength"].outputs[0].default_value']
+    assert [s.default_value for s in ng.nodes["Rotation"].inputs[:3]] == [0.0, 0.0, 0.0]
+    np.testing.assert_array_equal(world_mod.world_parameters(scene)["Rotation"], 0.0)
+
+    # a world without an image: the group goes, the World term is off
+    world.node_tree.links.remove(bg.inputs["Color"].links[0])
+    assert world_mod.sync_world(scene, tmp_path, settings=small) is None
+    assert world_mod.WORLD_GROUP not in bpy.data.node_groups
+    assert world_mod.world_parameters(scene) is None
+    assert world_mod.sync_world(scene, tmp_path, settings=small) is None
+
+
+@pytest.fixture
+def sync_operator(bpy_module):
+    from rt_lookdev.addon.operators import RTL_OT_sync_world
+
+    bpy_module.utils.register_class(RTL_OT_sync_world)
+    yield bpy_module.ops.rtl.sync_world
+    bpy_module.utils.unregister_class(RTL_OT_sync_world)
+
+
+def test_sync_world_operator(bpy_module, world_mod, small, sync_operator, capfd, monkeypatch):
+    bpy = bpy_module
+    from rt_lookdev.core.environment import prefilter
+
+    # the operator bakes with the default settings; keep them small here
+    monkeypatch.setattr(prefilter, "PrefilterSettings", lambda: small)
+    scene = bpy.context.scene
+    assert sync_operator.poll()
+    assert sync_operator() == {'FINISHED'}
+    assert "RT Lit World term off: the scene has no World" in capfd.readouterr().out
+    _world(bpy, scene, _image(bpy, "env", _environment()))
+    assert sync_operator() == {'FINISHED'}
+    out = capfd.readouterr().out
+    assert "RT Lit World: 'env' baked in" in out and "0 RT Lit groups rebuilt" in out
+    record = dict(bpy.data.node_groups[world_mod.WORLD_GROUP]["rtl_world"])
+    assert record["prefiltered"].startswith(str(world_mod.default_cache_dir()))
+    assert sync_operator() == {'FINISHED'}
+    assert "RT Lit World: 'env' cached" in capfd.readouterr().out
+
+
+def test_sync_world_switches_the_rt_lit_term_and_drops_stale_images(bpy_module, world_mod, small, sync_operator,
+                                                                   monkeypatch, lut_dir):
+    """An RT Lit material gets the World term after a sync, a re-bake with other settings gives another
+    table (and the old packed image is removed), and a world without image removes the term and its image."""
+    bpy = bpy_module
+    from rt_lookdev.addon import materials, node_emit
+    from rt_lookdev.core.environment import prefilter
+    from rt_lookdev.core.lut import lookup
+
+    scene = bpy.context.scene
+    mesh = bpy.data.meshes.new("quad")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (1, 1, 0)], [], [(0, 1, 2)])
+    obj = bpy.data.objects.new("tri", mesh)
+    scene.collection.objects.link(obj)
+    mat = bpy.data.materials.new("rt")
+    obj.data.materials.append(mat)
+    settings_class = prefilter.PrefilterSettings
+    monkeypatch.setattr(prefilter, "PrefilterSettings", lambda: small)
+
+    def world_groups():
+        ng = mat.node_tree.nodes["RT Lit"].node_tree
+        return {name for name in node_emit.tree_node_counts(ng) if name.startswith("RTL Shade World")}
+
+    def env_images():
+        return sorted(i.name for i in bpy.data.images if i.name.startswith("RTL_env_"))
+
+    with lookup.use_lut_dir(lut_dir):
+        materials.assign_rt_lit(mat, scene=scene, lut_dir=lut_dir)
+        assert not world_groups() and not env_images()          # no world: nothing built or loaded
+        _world(bpy, scene, _image(bpy, "env", _environment()))
+        assert sync_operator() == {'FINISHED'}
+        first = dict(bpy.data.node_groups[world_mod.WORLD_GROUP]["rtl_world"])["table"]
+        assert len(world_groups()) == 1 and env_images() == [f"RTL_{first}"]
+
+        other = settings_class(32, 16, (0.0, 0.5, 1.0))
+        monkeypatch.setattr(prefilter, "PrefilterSettings", lambda: other)
+        assert sync_operator() == {'FINISHED'}
+        second = dict(bpy.data.node_groups[world_mod.WORLD_GROUP]["rtl_world"])["table"]
+        assert second != first and env_images() == [f"RTL_{second}"]
+        assert tuple(bpy.data.images[f"RTL_{second}"].size) == (32, 16 * 3)
+
+        scene.world.node_tree.nodes["Environment Texture"].image = None
+        assert sync_operator() == {'FINISHED'}
+        assert world_mod.WORLD_GROUP not in bpy.data.node_groups
+        assert not world_groups() and not env_images()
+
+
+def test_rt_lit_rebuilds_from_the_packed_image_when_the_cache_is_gone(bpy_module, world_mod, small, lut_dir,
+                                                                     tmp_path):
+    """The .blend carries the prefiltered image: with the cache file deleted (another machine), the RT
+    Lit group is traced from the packed pixels, gets the same stamp (no rebuild) and the same values."""
+    bpy = bpy_module
+    from rt_lookdev.addon import materials, node_emit
+    from rt_lookdev.core.lut import lookup
+    from rt_lookdev.core.materials.world import WorldEnvironment
+
+    scene = bpy.context.scene
+    _world(bpy, scene, _image(bpy, "env", _environment()))
+    record = world_mod.sync_world(scene, tmp_path / "cache", settings=small)
+    mat = bpy.data.materials.new("rt")
+    with lookup.use_lut_dir(lut_dir):
+        materials.assign_rt_lit(mat, scene=scene, lut_dir=lut_dir)
+        ng = mat.node_tree.nodes["RT Lit"].node_tree
+        stamp = ng["rtl_stamp"]
+        from_file = WorldEnvironment.load(record["prefiltered"], record["table"])
+        for path in (tmp_path / "cache").iterdir():
+            path.unlink()
+        node_emit._EXTRA_IMAGES.clear()
+        env, _ = materials.world_environment()
+        np.testing.assert_array_equal(env.table, from_file.table)
+        assert env.roughness_levels == from_file.roughness_levels == tuple(small.roughness)
+        again = materials.ensure_rt_lit_group(scene=scene, lut_dir=lut_dir)
+        assert again == ng and ng["rtl_stamp"] == stamp
+        bpy.data.images.remove(bpy.data.images[f"RTL_{record['table']}"])
+        with pytest.raises(RuntimeError, match="Sync RT Lit World again"):
+            materials.world_environment()
