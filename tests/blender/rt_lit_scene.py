@@ -1,4 +1,5 @@
-"""A small RT Lit scene for tests: one sphere, one light of every kind, an orthographic camera."""
+"""A small RT Lit scene for tests: one sphere, one light of every kind, an orthographic camera, and
+optionally a studio HDRI world (rotated by a Mapping node) for the World term."""
 from __future__ import annotations
 
 import numpy as np
@@ -23,15 +24,22 @@ def aim(obj, target=(0.0, 0.0, 0.0)):
     obj.rotation_quaternion = direction.to_track_quat("-Z", "Y")
 
 
-def build(features_by_material, kinds=None, resolution=48):
-    """Spheres side by side (one per (name, Features)) lit by the LIGHTS (``kinds`` filters them)."""
+def build(features_by_material, kinds=None, resolution=48, hdri=None, world_strength=0.7):
+    """Spheres side by side (one per (name, Features)) lit by the LIGHTS (``kinds`` filters them) and,
+    with ``hdri``, by that studio HDRI's World term."""
     import bmesh
     import bpy
 
+    from build_demo_scene import add_hdri_world
     from rt_lookdev.addon import materials
+    from rt_lookdev.addon import world as rtl_world
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
+    scene.world = None
+    if hdri:
+        add_hdri_world(bpy, scene, hdri, world_strength)
+    rtl_world.sync_world(scene)
     for name, ltype, shape, loc, energy, size, size_y, extra in LIGHTS:
         kind = {"RECTANGLE": "quad", "ELLIPSE": "disk"}.get(shape, ltype.lower())
         if kinds is not None and kind not in kinds:
@@ -69,7 +77,6 @@ def build(features_by_material, kinds=None, resolution=48):
     cam.rotation_euler = (np.pi / 2, 0.0, 0.0)
     scene.collection.objects.link(cam)
     scene.camera = cam
-    scene.world = None
     scene.render.resolution_x = resolution * count
     scene.render.resolution_y = resolution
     return scene
@@ -81,6 +88,7 @@ def numpy_radiance(scene, passes):
     import bpy
 
     from rt_lookdev.addon import materials
+    from rt_lookdev.addon import world as rtl_world
     from rt_lookdev.core.materials import rt_lit
     from rt_lookdev.core.materials.rt_lit_interface import Features
     from engine_parity import camera_incoming
@@ -90,6 +98,8 @@ def numpy_radiance(scene, passes):
     hit = np.linalg.norm(nrm, axis=-1) > 0.5
     out = np.zeros(pos.shape)
     lights = [(kind, materials.light_parameters(obj, kind)) for obj, kind in materials.scene_lights(scene)]
+    env = materials.world_environment()
+    world = None if env is None else (env[0], rtl_world.world_parameters(scene))
     for obj in scene.objects:
         if obj.type != "MESH":
             continue
@@ -101,5 +111,5 @@ def numpy_radiance(scene, passes):
         params = {k: (np.array(v) if isinstance(v, tuple) else v)
                   for k, v in materials.material_parameters(mat).items()}
         geo = {"Position": pos[mine], "Geometry Normal": nrm[mine], "Incoming": camera_incoming(scene, pos[mine])}
-        out[mine] = rt_lit.rt_lit_radiance(features, params, geo, lights)
+        out[mine] = rt_lit.rt_lit_radiance(features, params, geo, lights, world)
     return out, hit

@@ -1,5 +1,6 @@
-"""The RT Lit material in a scene: every light kind through drivers, against numpy; lights that
-move or change; save and reload without Python; folding by scene content."""
+"""The RT Lit material in a scene: every light kind and a studio HDRI world through drivers, against
+numpy; lights and world that move or change; save and reload without Python; folding by scene
+content."""
 from __future__ import annotations
 
 import json
@@ -57,11 +58,14 @@ def _set_material_values(scene):
             node.inputs[k].default_value = v
 
 
+HDRI = "forest"        # the demo scene's: its bake is cached once per test session
+
+
 def test_rt_lit_renders_like_numpy_and_follows_light_edits(empty_scene, lut_dir):
     from rt_lookdev.core.lut import lookup
 
     with lookup.use_lut_dir(lut_dir):
-        scene = rt_lit_scene.build(_features())
+        scene = rt_lit_scene.build(_features(), hdri=HDRI)
         _set_material_values(scene)
         before, hit = _render_and_compare(scene)
         # move and resize lights: drivers carry the change, no sync needed
@@ -73,6 +77,9 @@ def test_rt_lit_renders_like_numpy_and_follows_light_edits(empty_scene, lut_dir)
         spot.data.energy = 800.0
         spot.data.spot_size = 1.3
         scene.objects["Sun"].data.color = (1.0, 0.5, 0.25)
+        nodes = scene.world.node_tree.nodes
+        nodes["Background"].inputs["Strength"].default_value = 1.3
+        nodes["Mapping"].inputs["Rotation"].default_value = (0.4, -0.3, 2.5)
         after, _ = _render_and_compare(scene)
         changed = np.abs(after - before).max(axis=-1) > 1e-3
         assert changed[hit].mean() > 0.3
@@ -84,8 +91,9 @@ def test_scene_reloads_without_python_and_renders_identically(empty_scene, lut_d
     from rt_lookdev.core.lut import lookup
 
     with lookup.use_lut_dir(lut_dir):
-        scene = rt_lit_scene.build(_features())
+        scene = rt_lit_scene.build(_features(), hdri=HDRI)
         _set_material_values(scene)
+        scene.world.node_tree.nodes["Mapping"].inputs["Rotation"].default_value = (0.0, 0.2, -1.0)
         res = (scene.render.resolution_x, scene.render.resolution_y)
         here = render_cycles_passes(scene, res)["Combined"]
     blend = tmp_path / "rt_lit.blend"
@@ -130,7 +138,9 @@ def test_groups_carry_only_what_the_scene_and_material_need(empty_scene, lut_dir
         names = set(tree_node_counts(ng))
         assert any("Quad" in n for n in names) and any("Sun" in n for n in names)
         assert not any("Disk" in n or "Spot" in n or "Point" in n for n in names)     # no such lights
-        assert not any(w in n for n in names for w in ("Sheen", "Cloth", "Kulla", "CoD", "Wrapped"))
+        assert not any(w in n for n in names for w in ("Sheen", "Cloth", "Kulla", "CoD", "Wrapped", "World",
+                                                       "Environment"))         # no world image either
+        assert not any(i.name.startswith("RTL_env_") for i in bpy.data.images)
         assert max(tree_node_counts(ng).values()) <= MAX_GROUP_NODES
         # a light added later joins after a sync; the group is rebuilt in place
         data = bpy.data.lights.new("Late", "POINT")
