@@ -6,6 +6,10 @@ while an EXR file stores its top row first, so rows are flipped on write and on 
 (../shared/reference/blender_addon.md §3.2).  Header attributes are prefixed ``rtl.``;
 ``rtl.content_hash`` is the SHA-256 of the float32 table (table orientation, RGBA
 interleaved, little-endian), checked on every read.
+
+Files are written and read with the OpenEXR package when it is importable, else with the
+built-in pure-numpy writer and reader (exr_writer.py, exr_reader.py): Blender's bundled Python
+has no OpenEXR module.  Either writer's files read back identically with either reader.
 """
 from __future__ import annotations
 
@@ -13,6 +17,8 @@ import hashlib
 from pathlib import Path
 
 import numpy as np
+
+from . import exr_writer
 
 CHANNELS = ("R", "G", "B", "A")
 BAKE_COMMAND = "python scripts/bake_luts.py"
@@ -43,33 +49,46 @@ def content_hash(table):
 def write_table(path, table, metadata):
     """Write a (H, W, 4) table to ``path`` atomically; returns the content hash.
 
-    ``metadata`` maps attribute names (without the ``rtl.`` prefix) to str/int/float.
+    ``metadata`` maps attribute names (without the ``rtl.`` prefix) to str (EXR ``string``), int
+    (``int``, 32-bit; bool is stored as 0/1) or float (``float``, rounded to 32 bits).  Written with
+    the OpenEXR package when it is importable, else with the built-in writer (exr_writer.py; Blender's
+    bundled Python lacks the package): the same attributes, the same pixels, ZIP compression.
     """
-    try:
-        import OpenEXR
-    except ImportError as exc:
-        raise LutError("writing LUTs needs the OpenEXR package (pinned in requirements.lock); Blender's "
-                       "bundled Python lacks it: bake with `.venv/bin/python scripts/bake_luts.py`") from exc
-
     table = np.asarray(table, dtype=np.float32)
     if table.ndim != 3 or table.shape[2] != 4:
         raise ValueError(f"expected a (H, W, 4) table, got shape {table.shape}")
     if not np.all(np.isfinite(table)):
         raise ValueError(f"refusing to write non-finite values to {path}")
     digest = content_hash(table)
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-    for key, value in metadata.items():
-        header["rtl." + key] = value
-    header["rtl.content_hash"] = digest
+    attributes = {"rtl." + key: value for key, value in metadata.items()}
+    attributes["rtl.content_hash"] = digest
+    for name, value in attributes.items():       # the same checks whichever writer runs
+        exr_writer.attribute_value(name, value)
     stored = np.flipud(table)
     channels = {name: np.ascontiguousarray(stored[:, :, c]) for c, name in enumerate(CHANNELS)}
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
-    with OpenEXR.File(header, channels) as exr:
-        exr.write(str(tmp))
-    tmp.replace(path)
+    try:
+        _write_exr(tmp, channels, attributes)
+        tmp.replace(path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
     return digest
+
+
+def _write_exr(path, channels, attributes):
+    """Write {name: (H, W) float32, top row first} and attributes, ZIP-compressed, with the OpenEXR
+    package, or the built-in writer where it is absent."""
+    try:
+        import OpenEXR
+    except ImportError:
+        exr_writer.write(path, channels, attributes, compression="zip")
+        return
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage, **attributes}
+    with OpenEXR.File(header, channels) as exr:
+        exr.write(str(path))
 
 
 def read_header(path):
