@@ -16,7 +16,10 @@ Steps (each prints what it does):
    one EEVEE render compared with Cycles.
 6. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
    brute-force integrals, per technique, with an HTML report in <out>/validation/.
-7. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
+7. World validation (scripts/validate_world.py): the RT Lit World term under Blender's studio HDRIs
+   (Lambert vs Cycles Diffuse, SH-LTC CoD vs brute force, specular vs Cycles Glossy over a roughness
+   sweep, the white furnace, node render vs numpy, bake times), report in <out>/validation_world/.
+8. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
 """
 from __future__ import annotations
 
@@ -51,7 +54,7 @@ def _progress(group, done, total):
 
 
 def step_luts(lut_dir):
-    print(f"[1/7] LUTs in {lut_dir}", flush=True)
+    print(f"[1/8] LUTs in {lut_dir}", flush=True)
     records = bake.bake(lut_dir, progress=_progress, log=lambda line: print("      " + line, flush=True))
     status = catalog.lut_status(lut_dir)
     return {"records": [{"group": r.group, "state": r.state, "seconds": round(r.seconds, 2)} for r in records],
@@ -60,7 +63,7 @@ def step_luts(lut_dir):
 
 
 def step_numpy_checks(lut_dir):
-    print("[2/7] numpy energy checks", flush=True)
+    print("[2/8] numpy energy checks", flush=True)
     t0 = time.perf_counter()
     tables = lookup.EnergyTables(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -91,7 +94,7 @@ def step_numpy_checks(lut_dir):
 
 
 def step_demo(out_dir, lut_dir, eevee=True):
-    print("[5/7] demo lookdev scene: build, node counts, Cycles and EEVEE renders", flush=True)
+    print("[5/8] demo lookdev scene: build, node counts, Cycles and EEVEE renders", flush=True)
     import demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee,
@@ -101,7 +104,7 @@ def step_demo(out_dir, lut_dir, eevee=True):
 
 
 def step_validation(out_dir, lut_dir):
-    print("[6/7] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)", flush=True)
+    print("[6/8] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)", flush=True)
     import validate
 
     argv = ["--out", str(out_dir / "validation")] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
@@ -113,8 +116,22 @@ def step_validation(out_dir, lut_dir):
             "summary_markdown": "\n".join(lines) + f"\n\nFull report: `{out_dir / 'validation' / 'report.html'}`."}
 
 
+def step_world_validation(out_dir, lut_dir):
+    print("[7/8] world validation: the World term under the studio HDRIs (scripts/validate_world.py)", flush=True)
+    import validate_world
+
+    argv = ["--out", str(out_dir / "validation_world")] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
+    result = validate_world.run(validate_world.parse_args(argv), log=lambda line: print("      " + line, flush=True))
+    lines = ["| check | measured | threshold | |", "|---|---|---|---|"]
+    lines += [f"| {c['name']} | {c['measured']} | {c['threshold']} | {'ok' if c['ok'] else '**FAIL**'} |"
+              for c in result["checks"]]
+    report_md = out_dir / "validation_world" / "report.md"
+    return {"passed": bool(result["passed"]), "checks": result["checks"],
+            "summary_markdown": "\n".join(lines) + f"\n\nFull report (per HDRI and roughness): `{report_md}`."}
+
+
 def step_render(out_dir, lut_dir, resolution, samples):
-    print("[4/7] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
+    print("[4/8] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)", flush=True)
     import validate_energy  # imports bpy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -125,7 +142,7 @@ def step_render(out_dir, lut_dir, resolution, samples):
 
 
 def step_ltc(lut_dir):
-    print("[3/7] LTC area lights: random quads and disks vs brute force", flush=True)
+    print("[3/8] LTC area lights: random quads and disks vs brute force", flush=True)
     import benchmark_ltc
 
     t0 = time.perf_counter()
@@ -190,6 +207,9 @@ def write_report(report, out_dir):
     val = report.get("validation")
     lines += ["## Validation suite (node render, numpy, Cycles ground truth)", ""]
     lines += [val["summary_markdown"], ""] if val else ["Skipped (--skip-render).", ""]
+    world = report.get("world_validation")
+    lines += ["## World validation (the World term under the studio HDRIs)", ""]
+    lines += [world["summary_markdown"], ""] if world else ["Skipped (--skip-render).", ""]
     lines += [f"Overall: **{'PASS' if report['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
@@ -211,17 +231,20 @@ def main(argv=None):
         return 1
     report["numpy_checks"] = step_numpy_checks(args.lut_dir)
     report["ltc"] = step_ltc(args.lut_dir)
-    report["render"] = report["demo"] = report["validation"] = None
+    report["render"] = report["demo"] = report["validation"] = report["world_validation"] = None
     if not args.skip_render:
         report["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples)
         report["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee)
         report["validation"] = step_validation(args.out, args.lut_dir)
+        report["world_validation"] = step_world_validation(args.out, args.lut_dir)
     report["passed"] = bool(report["luts"]["passed"] and report["numpy_checks"]["passed"] and report["ltc"]["passed"]
                             and (report["render"] is None or report["render"].get("passed", False))
                             and (report["demo"] is None or report["demo"].get("passed", False))
-                            and (report["validation"] is None or report["validation"].get("passed", False)))
+                            and (report["validation"] is None or report["validation"].get("passed", False))
+                            and (report["world_validation"] is None
+                                 or report["world_validation"].get("passed", False)))
     report["seconds"] = time.perf_counter() - t0
-    print("[7/7] report", flush=True)
+    print("[8/8] report", flush=True)
     write_report(report, args.out)
     print((args.out / "report.md").read_text())
     print(f"report written to {args.out / 'report.md'} and report.json")
