@@ -7,11 +7,18 @@ random normals (mean / max relative = the L2 truncation error), the SH and prefi
 (forced), the cached re-run time, and the prefiltered radiance looked up (bilinear, between levels
 when needed) at random directions vs the brute-force split-sum integral.  For one HDRI, the
 importance-sampling method (Colbert & Krivanek 2007) against the FFT quadrature at texel centres.
+For large sources (a 4096 x 2048 and an 8192 x 4096 image made from forest.exr with an added sun),
+the bake's time and peak memory with the default source cap (``PrefilterSettings.max_source_width``)
+and without it (4096 only: 8K without the cap needs ~20 GB), and the levels' difference between the two.
+Results: ``--out`` (Markdown) and the same numbers as JSON beside it.
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import resource
+import subprocess
 import sys
 import tempfile
 import time
@@ -38,7 +45,89 @@ def _unit(rng, n):
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
+SUN_DIRECTION = (0.5, -0.6, 0.35)        # about 20 deg above the horizon
+SUN_RADIUS = np.radians(0.27)            # the real sun's angular radius
+SUN_RADIANCE = 1.0e5
+
+
+def large_source(width):
+    """forest.exr bilinearly enlarged to width x width / 2, plus a sun disk (``SUN_*``) with its edge
+    texels' coverage supersampled 4 x 4: detail that a 1024-wide source cannot hold."""
+    small = equirect.read_equirect(equirect.resolve_hdri("forest"))
+    h = width // 2
+    image = np.empty((h, width, 3), np.float32)
+    for s in range(0, h, 256):
+        image[s:s + 256] = equirect.sample_equirect(small, equirect.texel_directions(h, width, slice(s, s + 256)))
+    sun = np.asarray(SUN_DIRECTION) / np.linalg.norm(SUN_DIRECTION)
+    u, v = equirect.direction_to_uv(sun)
+    col, row = int(u * width), int((1.0 - v) * h)
+    pad = int(np.ceil(2.0 * SUN_RADIUS / (np.pi / h))) + 2
+    rows, cols = np.arange(row - pad, row + pad + 1), np.arange(col - pad, col + pad + 1)
+    sub = (np.arange(4) + 0.5) / 4.0
+    theta = np.pi * (rows[:, None] + sub[None, :]) / h                                  # (R, 4)
+    phi = np.pi - 2.0 * np.pi * (cols[:, None] + sub[None, :]) / width                  # (C, 4)
+    d = np.stack(np.broadcast_arrays(
+        np.sin(theta)[:, None, :, None] * np.cos(phi)[None, :, None, :],
+        np.sin(theta)[:, None, :, None] * np.sin(phi)[None, :, None, :],
+        np.cos(theta)[:, None, :, None]), axis=-1)                                      # (R, C, 4, 4, 3)
+    coverage = (d @ sun > np.cos(SUN_RADIUS)).mean(axis=(2, 3))
+    block = image[np.ix_(rows, cols % width)]
+    image[np.ix_(rows, cols % width)] = block * (1.0 - coverage[..., None]) + SUN_RADIANCE * coverage[..., None]
+    return image
+
+
+def _large_bake_child(width, cap, out_dir):
+    """Run in a child process (peak memory is per process): bake ``large_source(width)`` with the cap
+    ``cap``; prints one JSON line."""
+    image = large_source(width)
+    settings = prefilter.PrefilterSettings(max_source_width=cap)
+    t0 = time.perf_counter()
+    bake = prefilter.bake_environment_image(image, f"large{width}_cap{cap}", "benchmark", out_dir, settings,
+                                            force=True)
+    seconds = time.perf_counter() - t0
+    print(json.dumps({"width": width, "cap": cap, "seconds": seconds, "sh": bake.seconds["sh"],
+                      "prefiltered": bake.seconds["prefiltered"], "path": str(bake.prefiltered_path),
+                      "max_rss_gb": _peak_memory_gb()}))
+
+
+def _peak_memory_gb():
+    """This process's peak resident memory: VmHWM (Linux; ru_maxrss would include the parent's peak,
+    which Linux keeps across execve), else ru_maxrss."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 2 ** 20
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20
+
+
+def _large_bake(width, cap, out_dir):
+    cmd = [sys.executable, __file__, "--large-bake-child", str(width), str(cap), str(out_dir)]
+    done = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def large_source_rows(tmp, default_cap):
+    """Bake times and peak memory of large sources with and without the cap, and per level the
+    relative difference (sum over RGB) between the capped and the full-resolution levels."""
+    runs = [_large_bake(4096, default_cap, tmp), _large_bake(4096, 4096, tmp), _large_bake(8192, default_cap, tmp)]
+    capped, _, _ = prefilter.read_prefiltered(runs[0]["path"])
+    full, levels, _ = prefilter.read_prefiltered(runs[1]["path"])
+    diff = []
+    for k, r in enumerate(levels):
+        rel = _rel(capped[k].astype(np.float64), full[k].astype(np.float64))
+        diff.append({"r": r, "mean": float(rel.mean()), "p99": float(np.percentile(rel, 99)), "max": float(rel.max())})
+    for run in runs:
+        print(f"large source {run['width']} cap {run['cap']}: {run['seconds']:.1f} s "
+              f"(SH {run['sh']:.1f} s), peak {run['max_rss_gb']:.2f} GB", flush=True)
+    return runs, diff
+
+
 def main(argv=None):
+    if argv is None and len(sys.argv) > 1 and sys.argv[1] == "--large-bake-child":
+        _large_bake_child(int(sys.argv[2]), int(sys.argv[3]), sys.argv[4])
+        return 0
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--normals", type=int, default=500)
     p.add_argument("--dirs", type=int, default=128, help="random directions for the prefilter check")
@@ -73,6 +162,8 @@ def main(argv=None):
                   f"{baked.seconds['sh']:.2f} s, prefiltered {baked.seconds['prefiltered']:.2f} s; cached "
                   f"re-run {cached:.3f} s; prefiltered lookup mean rel "
                   + ", ".join(f"r={r}: {e.mean():.4f}" for r, e in zip(check_r, errs)), flush=True)
+
+        large_runs, large_diff = large_source_rows(tmp, settings.max_source_width)
 
     # importance sampling vs the FFT quadrature (exact at texel centres) on one HDRI
     image = equirect.read_equirect(equirect.resolve_hdri("sunset"))
@@ -123,12 +214,19 @@ def main(argv=None):
            "|---|" + "---|" * len(check_r)]
     for name, errs in pf_rows:
         md.append(f"| {name} | " + " | ".join(f"{e.mean():.4f} / {e.max():.4f}" for e in errs) + " |")
+    t_fft_med = float(np.median([line[1] for line in method_rows]))
+    t_is_med = float(np.median([line[5] for line in method_rows]))          # 256 samples, bias 0
+    e_is_mean = float(np.median([line[6] for line in method_rows]))
+    t_is1024 = float(np.median([line[15] for line in method_rows]))       # 1024 samples, bias 0
+    e_is1024 = float(np.median([line[16] for line in method_rows]))
     md += ["", "## Method: FFT quadrature vs importance sampling with filtered lookups", "",
            "sunset, one 128 x 64 level: the FFT quadrature's time and its max relative difference from the "
            "brute force at 7 rows of texel centres; importance sampling of the GGX NDF with trilinear mip "
            "lookups (Colbert & Krivanek 2007, lod = 1/2 log2(Omega_s / Omega_p) + bias) vs the FFT result at "
-           "every texel (mean and p90 relative).  The FFT quadrature is exact and costs about as much as 300 "
-           "importance samples per texel (1.3 s vs 1.0 s at 256), so it is the default; C&K's +1 level bias over-blurs here.", "",
+           f"every texel (mean and p90 relative).  Median over the three levels: FFT {t_fft_med:.2f} s, exact; "
+           f"256 importance samples {t_is_med:.2f} s at {100 * e_is_mean:.2f}% mean error, 1024 samples "
+           f"{t_is1024:.2f} s at {100 * e_is1024:.2f}%.  The FFT is the default: no noise and no mip bias; C&K's "
+           "+1 level bias over-blurs here.", "",
            "| r | FFT (s) | FFT vs brute force (max rel) | IS 256, bias 0: s / mean / p90 | IS 256, bias 1 | IS 1024, bias 0 |",
            "|---|---|---|---|---|---|"]
     for line in method_rows:
@@ -138,9 +236,32 @@ def main(argv=None):
             _, _, t_is, m, p = line[3 + 5 * i: 8 + 5 * i]
             cells.append(f"{t_is:.2f} / {m:.4f} / {p:.4f}")
         md.append(f"| {r} | {t_fft:.2f} | {e_fft:.1e} | " + " | ".join(cells) + " |")
+    md += ["", "## Large sources: the source cap", "",
+           f"`PrefilterSettings.max_source_width` = {settings.max_source_width}: a wider source is area-averaged "
+           "to that width before prefiltering (`prefilter.prefilter_source`); the SH projection always reads the "
+           f"full image.  Sources: forest.exr enlarged bilinearly, plus a sun disk of radius 0.27 deg and radiance "
+           f"{SUN_RADIANCE:g} about 20 deg above the horizon (edge texels supersampled), baked in a child process "
+           "each (peak memory = its peak resident set, VmHWM, the image included).", "",
+           "| source | cap | bake (s) | SH (s) | prefiltered (s) | peak memory (GB) |", "|---|---|---|---|---|---|"]
+    for run in large_runs:
+        md.append(f"| {run['width']} x {run['width'] // 2} | {run['cap']} | {run['seconds']:.1f} | {run['sh']:.1f} | "
+                  f"{run['prefiltered']:.1f} | {run['max_rss_gb']:.2f} |")
+    md += ["", f"Capped ({settings.max_source_width}) vs full-resolution (4096) levels of the 4096 x 2048 source, "
+           "relative difference per output texel (sum over RGB): the error the cap adds.", "",
+           "| r | mean | p99 | max |", "|---|---|---|---|"]
+    for d in large_diff:
+        md.append(f"| {d['r']:g} | {d['mean']:.1e} | {d['p99']:.1e} | {d['max']:.1e} |")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text("\n".join(md) + "\n")
-    print(f"wrote {args.out}")
+    results = {"cpus": os.cpu_count(), "date": time.strftime("%Y-%m-%d"),
+               "hdris": [{"name": n, "sh_irradiance_mean": m, "p90": p, "max": x, "sh_s": a, "prefiltered_s": b,
+                          "cached_s": c} for n, m, p, x, a, b, c in rows],
+               "prefiltered_lookup": [{"name": n, **{f"r{r}": {"mean": float(e.mean()), "max": float(e.max())}
+                                                     for r, e in zip(check_r, errs)}} for n, errs in pf_rows],
+               "large_sources": [{k: v for k, v in run.items() if k != "path"} for run in large_runs],
+               "cap_difference": large_diff}
+    args.out.with_suffix(".json").write_text(json.dumps(results, indent=1) + "\n")
+    print(f"wrote {args.out} and {args.out.with_suffix('.json')}")
     return 0
 
 

@@ -129,9 +129,11 @@ def texel_angles(h, w):
     return theta, phi
 
 
-def texel_directions(h, w):
-    """(H, W, 3) unit directions of the texel centres (image orientation, row 0 at the zenith)."""
+def texel_directions(h, w, rows=slice(None)):
+    """(H, W, 3) unit directions of the texel centres (image orientation, row 0 at the zenith); only
+    the ``rows`` (a slice) when given."""
     theta, phi = texel_angles(h, w)
+    theta = theta[rows]
     st, ct = np.sin(theta)[:, None], np.cos(theta)[:, None]
     return np.stack(np.broadcast_arrays(st * np.cos(phi)[None, :], st * np.sin(phi)[None, :], ct), axis=-1)
 
@@ -208,9 +210,10 @@ class Environment:
             return np.asarray(d, dtype=np.float64)
         return np.asarray(d, dtype=np.float64) @ rotation_z(self.rotation_z).T
 
-    def world_texel_directions(self):
-        """(H, W, 3) world directions of the texel centres: R_z(-rotation_z) applied to the image's."""
-        d = texel_directions(*self.shape)
+    def world_texel_directions(self, rows=slice(None)):
+        """(H, W, 3) world directions of the texel centres: R_z(-rotation_z) applied to the image's
+        (only the ``rows``, a slice, when given)."""
+        d = texel_directions(*self.shape, rows=rows)
         if self.rotation_z == 0.0:
             return d
         return d @ rotation_z(-self.rotation_z).T
@@ -279,6 +282,50 @@ def downsample(image, factor=2):
     num = weighted.reshape(h // f, f, w // f, f, c).sum(axis=(1, 3))
     den = row_w.reshape(h // f, f).sum(axis=1)[:, None, None] * f
     return (num / den).astype(image.dtype)
+
+
+def _rebin_segments(in_edges, out_edges):
+    """Split [in_edges[0], in_edges[-1]] (= the out_edges range) at both sets of bin edges: for each
+    piece, its input bin, its output bin and its length; and where each output bin's pieces start."""
+    knots = np.union1d(in_edges, out_edges)
+    mids = 0.5 * (knots[:-1] + knots[1:])
+    src = np.clip(np.searchsorted(in_edges, mids) - 1, 0, len(in_edges) - 2)
+    dst = np.clip(np.searchsorted(out_edges, mids) - 1, 0, len(out_edges) - 2)
+    starts = np.flatnonzero(np.r_[True, dst[1:] != dst[:-1]])
+    return src, np.diff(knots), starts
+
+
+def _rebin_axis(a, in_edges, out_edges, axis, chunk=1024):
+    """Means of the piecewise-constant ``a`` (bins ``in_edges`` along ``axis``) over the bins
+    ``out_edges``: each output is a positive-weight sum of the input bins it overlaps (no cumulative
+    sums, so a bright sun does not cost dark neighbours their precision).  Chunked along the other
+    image axis to bound memory."""
+    src, length, starts = _rebin_segments(in_edges, out_edges)
+    widths = np.diff(out_edges)
+    a = np.moveaxis(a, axis, 0)
+    out = np.empty((len(widths),) + a.shape[1:], dtype=np.float64)
+    for s in range(0, a.shape[1], chunk):
+        part = a[:, s:s + chunk].astype(np.float64)[src] * length[:, None, None]
+        out[:, s:s + chunk] = np.add.reduceat(part, starts, axis=0) / widths[:, None, None]
+    return np.moveaxis(out, 0, axis)
+
+
+def resample_area(image, height, width):
+    """Area average of an equirect image onto a ``height`` x ``width`` grid of any size: every output
+    texel is the solid-angle-weighted mean of the parts of the input texels it covers, so the image's
+    integral over every output texel is preserved exactly (rows are binned in cos(theta), in which a
+    texel's solid angle is linear).  ``downsample`` is the special case of power-of-two factors."""
+    image = np.asarray(image)
+    h, w = image.shape[:2]
+    if height < 1 or width < 1:
+        raise ValueError(f"cannot resample to {width}x{height}")
+    if (h, w) == (height, width):
+        return image.copy()
+    s_in, s_out = 1.0 - np.cos(PI * np.arange(h + 1) / h), 1.0 - np.cos(PI * np.arange(height + 1) / height)
+    s_in[-1] = s_out[-1] = 2.0                          # the same end point for both grids
+    rows = _rebin_axis(image, s_in, s_out, axis=0)
+    cols = _rebin_axis(rows, np.arange(w + 1) / w, np.arange(width + 1) / width, axis=1)
+    return cols.astype(image.dtype)
 
 
 def mip_chain(image, min_height=1):

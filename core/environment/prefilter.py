@@ -23,7 +23,9 @@ centre, computed per (output row, source row) pair as a circular correlation in 
 longitude difference.  Measured (docs/benchmarks/environment.md): equal to the brute force to ~1e-7
 relative, about 1.2 s per level (1024 x 512 source, 128 x 64 output), no noise, no mip bias.
 Level r = 0 (and any lobe narrower than a source texel) is the mirror limit: the source area-averaged
-to the output resolution.
+to the output resolution.  A source wider than ``PrefilterSettings.max_source_width`` (1024) is first
+area-averaged to that width (``prefilter_source``), which bounds the bake's time and memory for 4K-16K
+HDRIs; the SH projection always uses the full image.
 
 Alternative (``method="importance"``, kept for the measured comparison): importance sampling of the
 GGX NDF (Karis 2013, ``ImportanceSampleGGX``: phi = 2 pi xi_1, cos theta_h = sqrt((1 - xi_2)/(1 +
@@ -89,9 +91,17 @@ class PrefilterSettings:
     method: str = "fft"           # "fft" (exact quadrature) or "importance" (Colbert & Krivanek 2007)
     samples: int = 256            # importance only
     lod_bias: float = 0.0         # importance only (C&K use 1; measured worse here)
+    max_source_width: int = 1024  # wider sources are area-averaged to this first (``prefilter_source``)
+
+    def __post_init__(self):
+        ratio = self.max_source_width / self.width
+        if self.max_source_width < self.width or ratio != 2 ** round(math.log2(ratio)):
+            raise ValueError(f"max_source_width must be the output width {self.width} times a power of two, "
+                             f"got {self.max_source_width}")
 
     def as_dict(self):
-        d = {"width": self.width, "height": self.height, "roughness": list(self.roughness), "method": self.method}
+        d = {"width": self.width, "height": self.height, "roughness": list(self.roughness), "method": self.method,
+             "max_source_width": self.max_source_width}
         if self.method == "importance":
             d.update(samples=self.samples, lod_bias=self.lod_bias)
         return d
@@ -186,6 +196,19 @@ def _power_of_two_source(image, width):
     return equirect.sample_equirect(image, dirs).astype(np.float32)
 
 
+def prefilter_source(image, settings):
+    """The source the levels are computed from: an image wider than ``settings.max_source_width`` is
+    area-averaged (``equirect.resample_area``) to max_source_width x max_source_width / 2, any other
+    goes through ``_power_of_two_source``.  The quadrature's time grows with the source's texel count
+    (FFT: O(H_o H_s W_s log W_s)) and its memory with an output chunk times the source, so at the
+    default cap a 4K or 8K HDRI costs what a 1024 x 512 one does.  docs/benchmarks/environment.md
+    measures time, peak memory and the levels' difference with and without the cap."""
+    image = np.asarray(image, dtype=np.float32)
+    if image.shape[1] > settings.max_source_width:
+        return equirect.resample_area(image, settings.max_source_width // 2, settings.max_source_width)
+    return _power_of_two_source(image, settings.width)
+
+
 def prefilter_level(mips, roughness, width, height, samples, lod_bias=0.0, rows=None):
     """One prefiltered level (height, width, 3) float32 in the image frame (or only ``rows``)."""
     alpha = alpha_of(roughness)
@@ -261,7 +284,7 @@ def prefilter(image, settings=PrefilterSettings(), progress=None):
     total)`` after every level."""
     if settings.method not in ("fft", "importance"):
         raise ValueError(f"unknown prefilter method {settings.method!r} (fft, importance)")
-    image = _power_of_two_source(np.asarray(image, dtype=np.float32), settings.width)
+    image = prefilter_source(image, settings)
     mips = equirect.mip_chain(image)
     mirror = mips[int(round(math.log2(image.shape[1] / settings.width)))]
     out = np.empty((len(settings.roughness), settings.height, settings.width, 3), np.float32)
@@ -444,7 +467,11 @@ def bake_environment_image(image, name, source, out_dir, settings=PrefilterSetti
                        "v = (k + clamp(1 - acos(z)/pi, 0.5/H, 1 - 0.5/H)) / L"),
             "roughness_levels": json.dumps(list(settings.roughness)),
             "layout_version": LAYOUT_VERSION, "generator": GENERATOR, "generator_version": GENERATOR_VERSION,
-            "samples": int(settings.samples), "sampler": "hammersley-2d+ggx-ndf, trilinear mip lookups (Colbert-Krivanek 2007)",
+            "method": (f"importance: {settings.samples} hammersley-2d+ggx-ndf samples, trilinear mip lookups "
+                       "(Colbert-Krivanek 2007)" if settings.method == "importance" else
+                       "fft: exact quadrature over the source texels (prefilter_level_fft)"),
+            "source_size": f"{image.shape[1]} x {image.shape[0]}, prefiltered from "
+                           f"{min(image.shape[1], settings.max_source_width)} wide",
             "params": json.dumps(params, sort_keys=True), "inputs_hash": pf_hash,
             "source": source, "source_hash": source_hash})
         states["prefiltered"] = "baked"

@@ -54,7 +54,7 @@ def per_coefficient(zonal):
 
 # --- projection --------------------------------------------------------------------------------
 
-def sh_project(env, rule="fejer"):
+def sh_project(env, rule="fejer", rows_per_chunk=128):
     """(9, 3) SH coefficients L_lm = int L(w) Y_lm(w) dw (R&H 2001, eq. 6) of an environment.
 
     ``env``: an ``equirect.Environment`` (rotation and strength applied: the coefficients are those
@@ -66,10 +66,14 @@ def sh_project(env, rule="fejer"):
     if not isinstance(env, equirect.Environment):
         env = equirect.Environment(np.asarray(env))
     h, w = env.shape
-    weights = equirect.quadrature_weights(h, w, rule)
-    basis = sh9_basis(env.world_texel_directions())                      # (H, W, 9)
-    image = np.asarray(env.image, dtype=np.float64)
-    return env.strength * np.einsum("hwi,hw,hwc->ic", basis, weights, image)
+    row_weights = equirect.quadrature_weights(h, 1, rule)[:, 0] / w     # every texel of a row alike
+    total = np.zeros((9, 3))
+    for s in range(0, h, rows_per_chunk):        # bounded memory for 8K-16K images
+        rows = slice(s, s + rows_per_chunk)
+        basis = sh9_basis(env.world_texel_directions(rows))                   # (rows, W, 9)
+        image = np.asarray(env.image[rows], dtype=np.float64)
+        total += np.einsum("hwi,h,hwc->ic", basis, row_weights[rows], image)
+    return env.strength * total
 
 
 def sh_rotate_z(coeffs, angle):

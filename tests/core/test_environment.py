@@ -82,6 +82,23 @@ def test_downsample_preserves_integral():
         np.testing.assert_allclose(eq.integrate(small, rule="area"), eq.integrate(img, rule="area"), rtol=1e-12)
 
 
+def test_resample_area_preserves_every_texels_integral():
+    img = np.random.default_rng(12).random((64, 128, 3))
+    img[20, 40] = 1e5                                             # a sun: no cumulative-sum cancellation
+    for f in (2, 4, 8):                                           # power-of-two factors: downsample
+        np.testing.assert_allclose(eq.resample_area(img, 64 // f, 128 // f), eq.downsample(img, f), rtol=1e-12)
+    for h, w in ((24, 48), (17, 40), (100, 200)):                # any size, up or down
+        out = eq.resample_area(img, h, w)
+        np.testing.assert_allclose(eq.integrate(out, rule="area"), eq.integrate(img, rule="area"), rtol=1e-13)
+    # a factor of 3: each output texel is the solid-angle-weighted mean of a 3 x 3 block
+    img3 = img[:48, :96]
+    out = eq.resample_area(img3, 16, 32)
+    rows = eq.texel_solid_angles(48, 1)[6:9, 0]
+    expect = (img3[6:9, 15:18] * rows[:, None, None]).sum(axis=(0, 1)) / (3 * rows.sum())
+    np.testing.assert_allclose(out[2, 5], expect, rtol=1e-12)
+    np.testing.assert_allclose(eq.resample_area(np.full((30, 60, 3), 2.5), 16, 32), 2.5, rtol=1e-14)
+
+
 # --- SH projection ------------------------------------------------------------------------------------
 
 def test_sh_projection_of_constant_is_exact():
@@ -113,6 +130,17 @@ def test_sh_projection_of_a_cosine_lobe():
     img = np.repeat(_image_of(lambda w: np.maximum(w @ d, 0.0), 256, 512)[..., None], 3, axis=-1)
     err = np.abs(sh.sh_project(img)[:, 0] - sh.sh_eval_cosine_lobe(d)).max()
     assert err < 1e-6
+
+
+def test_sh_projection_in_row_chunks_equals_one_pass():
+    img = np.random.default_rng(13).random((40, 80, 3))
+    for env in (img, eq.Environment(img, rotation_z=0.9, strength=1.3)):
+        for rule in ("fejer", "area"):
+            whole = sh.sh_project(env, rule, rows_per_chunk=1000)
+            np.testing.assert_allclose(sh.sh_project(env, rule, rows_per_chunk=7), whole, rtol=1e-12, atol=1e-14)
+    directions = eq.Environment(img, rotation_z=0.9).world_texel_directions()
+    np.testing.assert_array_equal(eq.Environment(img, rotation_z=0.9).world_texel_directions(slice(5, 9)),
+                                  directions[5:9])
 
 
 def test_sh_world_rotation_and_strength():
@@ -191,6 +219,25 @@ def test_prefiltered_r0_is_the_downsampled_source_and_constant_stays_constant():
     const_is = pf.prefilter(np.full((64, 128, 3), 0.75, np.float32),
                             pf.PrefilterSettings(32, 16, (0.0, 0.5), method="importance", samples=64))
     np.testing.assert_allclose(const_is, 0.75, rtol=1e-5)
+
+
+def test_wide_sources_are_area_averaged_to_the_cap_first():
+    rng = np.random.default_rng(14)
+    img = rng.random((128, 256, 3)).astype(np.float32)
+    img[30, 100] = 5e3
+    capped = pf.PrefilterSettings(16, 8, (0.0, 0.5, 1.0), max_source_width=64)
+    small = eq.resample_area(img, 32, 64)
+    np.testing.assert_array_equal(pf.prefilter_source(img, capped), small)
+    np.testing.assert_allclose(pf.prefilter(img, capped), pf.prefilter(small, capped), rtol=1e-6)
+    full = pf.PrefilterSettings(16, 8, (0.0, 0.5, 1.0), max_source_width=256)
+    assert pf.prefilter_source(img, full).shape == img.shape
+    # the cap is a parameter of the bake (another cap: another cache entry and table name)
+    assert capped.as_dict() != full.as_dict()
+    # a source at or below the cap is used as before
+    assert pf.prefilter_source(small, capped).shape == small.shape
+    for bad in (100, 8):
+        with pytest.raises(ValueError, match="max_source_width"):
+            pf.PrefilterSettings(16, 8, max_source_width=bad)
 
 
 def test_prefiltered_fft_equals_brute_force():
