@@ -274,14 +274,10 @@ def downsample(image, factor=2):
         return image.copy()
     if f < 1 or f & (f - 1):
         raise ValueError(f"downsample factor must be a power of two, got {factor}")
-    h, w, c = image.shape
+    h, w = image.shape[:2]
     if h % f or w % f:
         raise ValueError(f"image {w}x{h} is not divisible by {f}")
-    row_w = texel_solid_angles(h, 1)[:, 0]                       # per-row solid angle
-    weighted = image.astype(np.float64) * row_w[:, None, None]
-    num = weighted.reshape(h // f, f, w // f, f, c).sum(axis=(1, 3))
-    den = row_w.reshape(h // f, f).sum(axis=1)[:, None, None] * f
-    return (num / den).astype(image.dtype)
+    return resample_area(image, h // f, w // f)
 
 
 def _rebin_segments(in_edges, out_edges):
