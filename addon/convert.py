@@ -17,7 +17,7 @@ the RT Lit group datablock is left alone.  The RT Lit-only inputs (Wrap, Cloth .
 Principled counterpart: their unlinked values are remembered on the material and restored on the
 next conversion.
 
-The material remembers its switches in ``material["rtl_features"]`` (a dict of ``Features``);
+The material remembers its switches in ``material[common.FEATURES_KEY]`` (a dict of ``Features``);
 a conversion without explicit features reuses them.  Converting an RT Lit material again is
 idempotent: no nodes are added, the group is swapped only when the features ask for another one.
 
@@ -33,6 +33,7 @@ from bpy.props import BoolProperty, EnumProperty
 
 from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, RT_LIT_INPUTS, SPECULAR_MODELS,
                                                Features)
+from .common import FEATURES_KEY, RT_LIT_NODE_NAME
 
 #: Principled BSDF input -> RT Lit input (same names).  "Normal" is link-only.
 MAPPED_INPUTS = (
@@ -44,14 +45,12 @@ LINK_ONLY_INPUTS = ("Normal",)
 #: RT Lit inputs with no Principled counterpart; their values are remembered on the material.
 RT_LIT_ONLY_INPUTS = tuple(name for name in RT_LIT_INPUTS if name not in MAPPED_INPUTS)
 
-RT_LIT_NODE_NAME = "RT Lit"
 EMISSION_NODE_NAME = "RT Lit Emission"
 FRAME_NODE_NAME = "RT Lit Kept Principled"
 FRAME_LABEL = "Original Principled (kept for conversion back)"
 RT_LIT_OUTPUT = "Shader"
 
-#: Custom properties.  On the material:
-FEATURES_PROP = "rtl_features"          # dict of Features: the material's switches
+#: Custom properties.  On the material: ``common.FEATURES_KEY`` (dict of Features: the switches) and
 RT_ONLY_VALUES_PROP = "rtl_rt_only"     # dict: RT Lit-only input values, kept while Principled
 #: On nodes this module creates or keeps:
 ROLE_PROP = "rtl_role"                  # "rt_lit" | "emission" | "frame" | "kept_principled"
@@ -261,7 +260,7 @@ def ignored_principled_inputs(node):
 
 def stored_features(material):
     """The features remembered on the material, or None."""
-    data = material.get(FEATURES_PROP) if material is not None else None
+    data = material.get(FEATURES_KEY) if material is not None else None
     if data is None:
         return None
     try:
@@ -275,7 +274,7 @@ def stored_features(material):
 
 
 def _store_features(material, features):
-    material[FEATURES_PROP] = features.as_dict()
+    material[FEATURES_KEY] = features.as_dict()
 
 
 def _absolute_location(node):
@@ -523,10 +522,12 @@ TARGET_ITEMS = (
 )
 
 
-def default_group_factory():
-    """The add-on's RT Lit group factory (imported lazily: ``.materials`` is optional here)."""
+def default_group_factory(lut_dir=None):
+    """The add-on's RT Lit group factory, reading the LUTs of ``lut_dir`` (imported lazily:
+    ``.materials`` is optional here)."""
     from .materials import ensure_rt_lit_group
-    return ensure_rt_lit_group
+
+    return lambda features: ensure_rt_lit_group(features, lut_dir=lut_dir)
 
 
 def _active_material(context):
@@ -644,7 +645,9 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
                 " (no selected object has a material)" if self.target == 'SELECTED' else ""))
             return {'CANCELLED'}
         try:
-            factory = default_group_factory()
+            from . import preferences
+
+            factory = default_group_factory(preferences.lut_directory(context))
         except ImportError as ex:
             self.report({'ERROR'}, f"The RT Lit node group is not available: {ex}")
             return {'CANCELLED'}

@@ -4,6 +4,7 @@ from __future__ import annotations
 import bpy
 
 from . import preferences
+from .common import WORLD_GROUP
 
 #: States that make the tables unusable: the operator fails on these.
 ERROR_STATES = ("corrupt", "mismatch")
@@ -116,7 +117,7 @@ class RTL_OT_sync_lights(bpy.types.Operator):
             return {'CANCELLED'}
         kinds = ", ".join(f"{obj.name} ({kind})" for obj, kind in records) or "none"
         message = f"RT Lit: {len(records)} lights [{kinds}]; {len(groups)} RT Lit groups rebuilt"
-        has_world = materials.WORLD_GROUP in bpy.data.node_groups
+        has_world = WORLD_GROUP in bpy.data.node_groups
         budget = CYCLES_LIGHT_BUDGET_WITH_WORLD if has_world else CYCLES_LIGHT_BUDGET
         if len(records) > budget:
             # Cycles' SVM stack (255 floats per material) limits the lights one material can shade
@@ -142,20 +143,19 @@ class RTL_OT_add_node_groups(bpy.types.Operator):
         return _lut_directory_exists(cls, context)
 
     def execute(self, context):
-        from ..core.lut import lookup
-        from ..node_groups import catalog
+        from ..core.lut.lookup import LutSet
+        from ..node_groups import library
         from . import node_emit
 
-        lut_dir = preferences.lut_directory(context)
+        tables = LutSet.from_folder(preferences.lut_directory(context))
         wm = context.window_manager
-        functions = catalog.all_functions()
+        functions = library.all_functions()
         before = set(bpy.data.node_groups.keys())
         try:
-            with lookup.use_lut_dir(lut_dir):
-                wm.progress_begin(0, len(functions))
-                for i, fn in enumerate(functions):
-                    node_emit.ensure_function_group(fn, lut_dir)
-                    wm.progress_update(i + 1)
+            wm.progress_begin(0, len(functions))
+            for i, fn in enumerate(functions):
+                node_emit.ensure_function_group(fn, tables)
+                wm.progress_update(i + 1)
         except Exception as ex:
             self.report({'ERROR'}, f"Could not build the node groups: {ex}")
             return {'CANCELLED'}
@@ -183,7 +183,8 @@ class RTL_OT_sync_world(bpy.types.Operator):
         return True
 
     def execute(self, context):
-        from . import materials, world
+        from . import materials
+        from . import world_sync as world
 
         scene = context.scene
         lut_dir = preferences.lut_directory(context)

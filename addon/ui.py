@@ -16,12 +16,13 @@ class RTL_PT_material(bpy.types.Panel):
 
     def draw(self, context):
         from . import convert
+        from .common import FEATURES_KEY
 
         layout = self.layout
         mat = context.material
         col = layout.column(align=True)
         if convert.is_rt_lit_material(mat):
-            features = mat.get("rtl_features", {})
+            features = mat.get(FEATURES_KEY, {})
             col.label(text="RT Lit: " + ", ".join(f"{k} {v}" for k, v in dict(features).items()))
             col.operator("rtl.convert_to_rt_lit", text="Change Switches")
             col.operator("rtl.convert_to_principled", icon='MATERIAL')
@@ -45,7 +46,7 @@ class RTL_PT_world(bpy.types.Panel):
         return context.scene is not None
 
     def draw(self, context):
-        from . import world
+        from . import world_sync as world
 
         layout = self.layout
         setup = world.world_setup(context.scene.world)

@@ -54,14 +54,6 @@ COSINE_LOBE_ZONAL = (1.0, 2.0 / 3.0, 0.25)
 COD_TABLE = "ltc_cod_diffuse"
 
 
-def _tables(tables):
-    if tables is not None:
-        return tables
-    from .lut import lookup
-
-    return lookup.default_ltc_tables()
-
-
 def coefficient_list(coeffs):
     """The 9 RGB coefficients as a list of 9 vectors, from a sequence of 9 vectors or a (..., 9, 3) array."""
     if isinstance(coeffs, (list, tuple)):
@@ -181,7 +173,7 @@ def ltc_lobe_axis(c, frame, axis="talk"):
 def cod_lobe(tables, n, v, roughness, axis="talk"):
     """(unit lobe axis, LTC magnitude) of the CoD multiscattering diffuse at this shading point."""
     mu = op.saturate(op.dot(n, v))
-    c, magnitude, _ = _tables(tables).lookup(COD_TABLE, mu, roughness)
+    c, magnitude, _ = tables.ltc(COD_TABLE, mu, roughness)
     return op.normalize(ltc_lobe_axis(c, polygon.local_frame(n, v), axis)), magnitude
 
 
@@ -196,7 +188,7 @@ def sh_cod_diffuse_magnitude_only(tables, coeffs9, n, v, roughness, albedo):
     """The talk's comparison, "scaling by the BRDF magnitude only": the cosine lobe about N times the
     CoD table's magnitude and the albedo."""
     mu = op.saturate(op.dot(n, v))
-    _, magnitude, _ = _tables(tables).lookup(COD_TABLE, mu, roughness)
+    _, magnitude, _ = tables.ltc(COD_TABLE, mu, roughness)
     return op.vmul(op.scale(sh_cosine_lobe_eval(coeffs9, n), magnitude), albedo)
 
 

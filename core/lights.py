@@ -9,8 +9,7 @@ in world space, quaternion mode: mat4_decompose of ``matrix_world``), and the li
 (``energy``, ``color``, ``size``, ``size_y``, ``spot_size``, ``spot_blend``).
 
 Cycles 5.0 conventions (source: blender/blender ``intern/cycles``; measured with the bpy 5.0.1
-module in tests/blender/test_light_units.py; see ../shared/reference/blender_addon.md, appendix
-"Cycles light units"):
+module in tests/blender/test_light_units.py; see docs/blender.md, "Cycles light units"):
 
 - Strength.  The Blender sync (``blender/light.cpp: sync_light``) sets the light's strength to
   ``color * energy`` (energy = Power P in W for point, spot and area lights, Strength S in W/m^2

@@ -12,6 +12,9 @@ import numpy as np
 from . import shading_ops as op
 from .conventions import COS_EPS
 from .fresnel import fresnel_average
+from .ir.functions import NodeFunction
+from .ir.interface import color, factor
+from .lut.lookup import REFERENCES
 
 #: Floor for 1 - E_avg, which tends to 0 with roughness (r = 0: 1 - E_avg < 1e-7).
 #: The lobe's numerator (1 - E(mu_o))(1 - E(mu_i)) vanishes faster, so f_ms -> 0.
@@ -103,3 +106,43 @@ def fdez_aguera_area_scale(f0, e, f90=1.0):
     f_avg = fresnel_average(f0, f90)
     lost = f_avg * (1.0 - e)
     return 1.0 + lost / op.maximum(1.0 - lost, COS_EPS)
+
+
+# --- node functions (offered to artists as stand-alone groups) --------------------------------------
+
+_F0 = color((0.04, 0.04, 0.04), "Specular reflectance at normal incidence F0 (Schlick, F90 = 1)")
+_E = factor(1.0, "Directional albedo E(mu_v) of the single-scattering lobe with F = 1")
+_SCALE_OUT = {"Scale": color((1.0, 1.0, 1.0), "Multiplies the single-scattering specular")}
+
+
+def _turquin_node(F0, E):
+    return {"Scale": op.per_channel(turquin_compensation, F0, E)}
+
+
+def _fdez_area_node(F0, E):
+    return {"Scale": op.per_channel(fdez_aguera_area_scale, F0, E)}
+
+
+# Fdez-Aguera 2019, eq. 11-16, with Karis 2013's split-sum table (scale, bias) at (mu_v, r).
+def _fdez_environment_node(tables, **kw):
+    scale, bias = tables.split_sum(op.saturate(kw["N.V"]), op.saturate(kw["Roughness"]))
+    fss = op.per_channel(lambda f0: fdez_aguera_terms(f0, scale, bias)[0], kw["F0"])
+    fms = op.per_channel(lambda f0: fdez_aguera_terms(f0, scale, bias)[1], kw["F0"])
+    return {"FssEss": fss, "FmsEms": fms}
+
+
+TURQUIN_COMPENSATION = NodeFunction(
+    "RTL Turquin Compensation", _turquin_node, {"F0": _F0, "E": _E}, _SCALE_OUT,
+    "Turquin 2019 multiple-scattering compensation of the specular lobe (view-dependent)")
+FDEZ_AGUERA_AREA_SCALE = NodeFunction(
+    "RTL Fdez-Aguera Area Scale", _fdez_area_node, {"F0": _F0, "E": _E}, _SCALE_OUT,
+    "The talk's approximation to Fdez-Aguera's multiple scattering under area lights")
+FDEZ_AGUERA_ENVIRONMENT_BRDF = NodeFunction(
+    "RTL Fdez-Aguera Environment BRDF", _fdez_environment_node,
+    {"F0": _F0, "N.V": factor(1.0, "mu_v = N.V, cosine of the view angle"),
+     "Roughness": factor(0.5, "Blender roughness r (GGX alpha = r^2)")},
+    {"FssEss": color((0.0, 0.0, 0.0), "Single-scattered energy: times prefiltered radiance"),
+     "FmsEms": color((0.0, 0.0, 0.0), "Multiply-scattered energy: times irradiance")},
+    "Fdez-Aguera 2019 multiple-scattering split-sum environment BRDF", tables=REFERENCES)
+
+NODE_FUNCTIONS = (TURQUIN_COMPENSATION, FDEZ_AGUERA_AREA_SCALE, FDEZ_AGUERA_ENVIRONMENT_BRDF)

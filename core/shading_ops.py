@@ -5,22 +5,10 @@ division, square root, inverse trigonometric function and normalisation is expli
 identical wherever the math is evaluated: in numpy here, and in Blender node groups later
 (the node-group backend maps each function to one Math / Vector Math node).
 
-Blender's Math node differs between engines (Cycles ``kernel/svm/math_util.h`` vs EEVEE
-``gpu_shader_common_math.glsl``; see ../shared/reference/blender_addon.md §2.5 and ltc.md
-§5.1).  The functions below pick, for each operation, the behaviour that both engines
-share once the inputs are guarded, and the shading code supplies those guards:
-
-==================  ======================================  ==============================
-operation           Cycles                                  EEVEE
-==================  ======================================  ==============================
-a / b               0 when b == 0                           0 when b == 0
-sqrt(a)             sqrt(max(a, 0))                         a > 0 ? sqrt(a) : 0
-inversesqrt(a)      a > 0 ? 1/sqrt(a) : 0                   unguarded  -> callers pass max(a, eps)
-acos(a), asin(a)    input clamped to [-1, 1]                0 outside [-1, 1] -> callers clamp
-pow(a, b)           0 for a < 0 and fractional b            same
-log(a, base)        0 for a <= 0                            same
-normalize(v)        zero vector for |v| = 0                 same (5.0 GLSL checks length)
-==================  ======================================  ==============================
+The rule behind each operation (what Blender's nodes compute where plain IEEE math would give
+NaN or Inf, and how EEVEE differs from Cycles) is stated once, in ``core.ir.semantics``; the numpy
+path below calls those rules, and the functions that need a guard the engines do not share
+(``inverse_sqrt``'s eps, the explicit clamp of ``acos`` / ``asin``) add it here, in both paths.
 
 All functions accept scalars or numpy arrays (float32 or float64) and broadcast; vectors
 are arrays whose last axis has length 3.  Given an IR expression (``core.ir.Expr``) as any
@@ -31,7 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .ir import semantics
 from .ir.expr import graph_of, is_expr
+from .ir.tables import bilinear_function
 
 
 def _node(op, *args):
@@ -50,17 +40,14 @@ def safe_div(a, b):
     """a / b with Blender's Divide semantics: 0 where b == 0."""
     if is_expr(a, b):
         return _node("divide", a, b)
-    a, b = np.broadcast_arrays(_arr(a), _arr(b))
-    out = np.zeros(a.shape, dtype=np.result_type(a, b))
-    np.divide(a, b, out=out, where=(b != 0))
-    return out
+    return semantics.divide(a, b)
 
 
 def sqrt(a):
     """Square root with Blender semantics: 0 for a <= 0."""
     if is_expr(a):
         return _node("sqrt", a)
-    return np.sqrt(np.maximum(_arr(a), 0.0))
+    return semantics.sqrt(a)
 
 
 def inverse_sqrt(a, eps):
@@ -69,21 +56,21 @@ def inverse_sqrt(a, eps):
         raise ValueError("inverse_sqrt needs an explicit eps > 0")
     if is_expr(a):
         return _node("inverse_sqrt", maximum(a, eps))
-    return 1.0 / np.sqrt(np.maximum(_arr(a), eps))
+    return semantics.inverse_sqrt(np.maximum(_arr(a), eps))
 
 
 def acos(a):
     """arccos of the input clamped to [-1, 1] (the clamp is explicit in nodes too)."""
     if is_expr(a):
         return _node("arccosine", clamp(a, -1.0, 1.0))
-    return np.arccos(np.clip(_arr(a), -1.0, 1.0))
+    return semantics.arccosine(a)
 
 
 def asin(a):
     """arcsin of the input clamped to [-1, 1]."""
     if is_expr(a):
         return _node("arcsine", clamp(a, -1.0, 1.0))
-    return np.arcsin(np.clip(_arr(a), -1.0, 1.0))
+    return semantics.arcsine(a)
 
 
 def exp(a):
@@ -103,10 +90,7 @@ def log2(a):
     """log2(a) with Blender's Logarithm semantics: 0 for a <= 0."""
     if is_expr(a):
         return _node("log2", a)
-    a = _arr(a)
-    out = np.zeros(a.shape, dtype=a.dtype)
-    np.log2(a, out=out, where=(a > 0))
-    return out
+    return semantics.log2(a)
 
 
 def pow5(a):
@@ -214,93 +198,30 @@ def tan(a):
     return np.tan(_arr(a))
 
 
-class Lut:
-    """A lookup table for shading code: its catalog name and its (H, W, 4) data."""
-
-    def __init__(self, name, table):
-        self.name, self.table = name, np.asarray(table)
-
-
 def floor(a):
     if is_expr(a):
         return _node("floor", a)
     return np.floor(_arr(a))
 
 
-def lut_sample(lut, u, v, channel):
-    """Channel of ``lut`` at texture coordinates (u, v), bilinear with EXTEND (Image Texture node,
-    Linear; core/lut/lookup.py for the texel-centre convention).
+def lut_sample(table, u, v, channel):
+    """Channel of ``table`` (a ``core.ir.tables.Table``) at texture coordinates (u, v), bilinear with
+    EXTEND (Image Texture node, Linear; the texel-centre rule of ``semantics.sample_bilinear``).
 
-    Traced, the bilinear filter is written out (``lut_bilinear_function``): four Closest fetches
-    and explicit weights.  EEVEE's Linear filtering selects mipmaps from screen-space derivatives
-    of the coordinates, which for a LUT indexed by per-pixel values blurred lookups by up to 40%
-    of the table's range (measured); Closest fetches are exact in both engines."""
+    Traced, the bilinear filter is written out (``tables.bilinear_function``): four Closest fetches
+    and explicit weights, exact in Cycles and EEVEE alike.  In numpy the table must hold its data."""
     if is_expr(u, v):
-        return lut_bilinear_function(lut)(u=u, v=v)["RGBA"[channel]]
-    from .lut.lookup import sample_bilinear
-
-    return sample_bilinear(lut.table, u, v)[..., channel]
+        return bilinear_function(table)(u=u, v=v)["RGBA"[channel]]
+    return semantics.sample_bilinear(table.require_data(), u, v)[..., channel]
 
 
-def texel_fetch(lut, u, v, channel):
-    """Channel of the texel of ``lut`` that contains (u, v), no filtering (Image Texture, Closest,
+def texel_fetch(table, u, v, channel):
+    """Channel of the texel of ``table`` that contains (u, v), no filtering (Image Texture, Closest,
     EXTEND): texel (floor(u W), floor(v H)) clamped to the table, row 0 at v = 0.  Traced: a
     ``texel`` node."""
     if is_expr(u, v):
-        g = graph_of(u, v)
-        g.luts.setdefault(lut.name, lut.table)
-        return g.make("texel", (u, v), (("table", lut.name), ("channel", channel)))
-    table = np.asarray(lut.table)
-    h, w = table.shape[:2]
-    i = np.clip(np.floor(np.asarray(u, np.float64) * w), 0, w - 1).astype(np.int64)
-    j = np.clip(np.floor(np.asarray(v, np.float64) * h), 0, h - 1).astype(np.int64)
-    return table[j, i][..., channel]
-
-
-_LUT_FUNCTIONS = {}
-
-
-def lut_bilinear_function(lut):
-    """The node function "RTL LUT <table>": (u, v) -> the four channels, bilinear, EXTEND."""
-    from .ir.functions import NodeFunction
-    from .ir.interface import Socket
-
-    cached = _LUT_FUNCTIONS.get(lut.name)
-    if cached is not None and cached[0] is lut.table:
-        return cached[1]
-    h, w = np.shape(lut.table)[:2]
-
-    # Bilinear filtering as Cycles' Linear Image Texture does it (texel centres at (i + 0.5)/W,
-    # coordinates clamped to the centres of the edge texels: EXTEND).
-    def axis(t, n):
-        x = clamp(t * n - 0.5, 0.0, n - 1.0)
-        x0 = minimum(floor(x), max(n - 2.0, 0.0))
-        return (x0 + 0.5) / n, (x0 + 1.5) / n if n > 1 else (x0 + 0.5) / n, x - x0
-
-    def body(u, v):
-        u0, u1, fu = axis(u, w)
-        v0, v1, fv = axis(v, h)
-        g = graph_of(u, v)
-        g.luts.setdefault(lut.name, lut.table)
-        # each tap is weighted and accumulated at once (one live tap at a time: Cycles' SVM stack
-        # holds 255 floats for a whole material, and a tap read by four later mixes stays live)
-        taps = ((u0, v0, (1.0 - fu) * (1.0 - fv)), (u1, v0, fu * (1.0 - fv)),
-                (u0, v1, (1.0 - fu) * fv), (u1, v1, fu * fv))
-        out = {}
-        for c, name in enumerate("RGBA"):
-            total = None
-            for uu, vv, weight in taps:
-                term = g.make("texel", (uu, vv), (("table", lut.name), ("channel", c))) * weight
-                total = term if total is None else total + term
-            out[name] = total
-        return out
-
-    coord = Socket("float", 0.5, description="Texture coordinate (texel centres at (i + 0.5)/N)")
-    fn = NodeFunction(f"RTL LUT {lut.name}", body, {"u": coord, "v": coord},
-                      {c: Socket("float", 0.0, description=f"Channel {c}, bilinear") for c in "RGBA"},
-                      f"Bilinear lookup of the {lut.name} table (four exact texel fetches; EXTEND)")
-    _LUT_FUNCTIONS[lut.name] = (lut.table, fn)
-    return fn
+        return graph_of(u, v).read_table(table, u, v, channel)
+    return semantics.texel_fetch(table.require_data(), u, v)[..., channel]
 
 
 # --- vector math (last axis = xyz) -------------------------------------------------------
@@ -361,8 +282,16 @@ def normalize(v):
     """v/|v|, and the zero vector for |v| == 0 (Blender's Vector Math Normalize)."""
     if is_expr(v):
         return _node("normalize", v)
-    v = _arr(v)
-    n = length(v)[..., None]
-    out = np.zeros(np.broadcast_shapes(v.shape, n.shape), dtype=v.dtype)
-    np.divide(v, n, out=out, where=(n > 0))
-    return out
+    return semantics.normalize(v)
+
+
+# --- colours (3-vectors) --------------------------------------------------------------------
+
+def per_channel(fn, rgb, *args):
+    """fn applied to each channel of a colour (a Separate/Combine XYZ pair in nodes)."""
+    return vec3(*(fn(component(rgb, i), *args) for i in range(3)))
+
+
+def splat(x):
+    """The grey colour (x, x, x)."""
+    return vec3(x, x, x)

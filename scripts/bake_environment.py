@@ -1,6 +1,7 @@
 """Bake one World HDRI: L2 SH coefficients and the GGX-prefiltered levels (cached by content hash).
 
-    python scripts/bake_environment.py --hdri forest --out out/environment [--force]
+    python scripts/bake_environment.py --hdri forest [--out out/environment] [--force]
+    python scripts/bake_environment.py --list
     python scripts/bake_environment.py --hdri /path/to/image.exr --out DIR [--width 128 --height 64]
 
 --hdri takes one of Blender's studio HDRIs (city, courtyard, forest, interior, night, studio,
@@ -15,19 +16,17 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _bootstrap  # noqa: E402
+from rt_lookdev.core.environment import equirect, prefilter
 
-_bootstrap.import_package()
-from rt_lookdev.core.environment import equirect, prefilter  # noqa: E402
+DEFAULT_OUT = Path(__file__).resolve().parents[1] / "out" / "environment"
 
 
 def _args(argv):
     if "--" in argv:
         argv = argv[argv.index("--") + 1:]
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--hdri", required=True, help="studio HDRI name or EXR path")
-    p.add_argument("--out", type=Path, required=True, help="output folder")
+    p.add_argument("--hdri", help="studio HDRI name or EXR path (required unless --list)")
+    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output folder (default: out/environment)")
     p.add_argument("--width", type=int, default=prefilter.PrefilterSettings.width)
     p.add_argument("--height", type=int, default=prefilter.PrefilterSettings.height)
     p.add_argument("--method", choices=("fft", "importance"), default="fft")
@@ -35,7 +34,10 @@ def _args(argv):
                    help="samples per texel (importance method only)")
     p.add_argument("--force", action="store_true", help="bake even if the files are current")
     p.add_argument("--list", action="store_true", help="list the studio HDRIs and exit")
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    if not args.list and not args.hdri:
+        p.error("--hdri is required (a studio HDRI name from --list, or an EXR path)")
+    return args
 
 
 def main(argv=None):

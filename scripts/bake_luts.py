@@ -10,10 +10,8 @@ import argparse
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _bootstrap  # noqa: E402,F401
-
-from rt_lookdev.core.lut import bake, catalog  # noqa: E402
+from rt_lookdev.core import lut_bake as bake
+from rt_lookdev.core.lut import catalog
 
 
 def _args(argv):

@@ -1,208 +1,21 @@
-"""Build the demo lookdev scene: spheres across roughness, metal, cloth, wrap and sheen, lit by a
-quad (rectangle) and a disk area light and a studio HDRI world (rotated by a Mapping node), every
-material converted from Principled to RT Lit.
+"""Build the demo lookdev scene and save it (``rt_lookdev.addon.demo_scene``).
 
     python scripts/build_demo_scene.py [--out out/demo/lookdev_demo.blend] [--lut-dir DIR]
                                        [--hdri forest|none] [--world-strength 0.5]
     blender --background --python scripts/build_demo_scene.py -- [same options]
 
-The HDRI is one of those inside Blender (``datafiles/studiolights/world``); its bake is cached
-(addon/world.py).  The world is invisible to Cycles' camera rays and has no importance map (the
-materials are emission only), so the background is black.
-
-The scene is emission-only (the RT Lit materials compute the lighting), so a 1-sample render
-is the material's exact per-pixel value; ``configure_demo_render`` sets that up for Cycles.
-"""
-from __future__ import annotations
-
-import argparse
+``--help`` lists the options."""
 import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _bootstrap  # noqa: E402,F401
-
-REPO = Path(__file__).resolve().parents[1]
-DEFAULT_OUT = REPO / "out" / "demo" / "lookdev_demo.blend"
-
-ROUGHNESS = (0.05, 0.25, 0.5, 0.75, 1.0)
-SPACING = 1.0
-RADIUS = 0.42
-
-#: (row label, Principled inputs, RT Lit features) per row; roughness sweeps along the row.
-ROWS = (
-    ("dielectric", {"Base Color": (0.8, 0.25, 0.1, 1.0), "Metallic": 0.0},
-     {"specular": "turquin", "diffuse": "cod"}),
-    ("metal", {"Base Color": (1.0, 0.78, 0.34, 1.0), "Metallic": 1.0},
-     {"specular": "kulla_conty", "diffuse": "lambert"}),
-)
-
-#: The third row: one sphere per variant at roughness 0.5.
-VARIANTS = (
-    ("cloth", {"Base Color": (0.1, 0.2, 0.6, 1.0), "Roughness": 0.6},
-     {"specular": "single", "diffuse": "cod", "cloth": True}, {"Cloth Weight": 1.0,
-                                                              "Cloth Color": (0.9, 0.7, 0.8, 1.0)}),
-    ("wrap", {"Base Color": (0.85, 0.55, 0.45, 1.0), "Roughness": 0.5},
-     {"specular": "turquin", "diffuse": "wrapped"}, {"Wrap": 0.5}),
-    ("sheen", {"Base Color": (0.3, 0.05, 0.05, 1.0), "Roughness": 0.7, "Sheen Weight": 1.0,
-               "Sheen Tint": (1.0, 1.0, 1.0, 1.0)},
-     {"specular": "turquin", "diffuse": "cod", "sheen": True}, {}),
-    ("fdez", {"Base Color": (0.95, 0.64, 0.54, 1.0), "Metallic": 1.0, "Roughness": 0.4},
-     {"specular": "fdez_aguera", "diffuse": "lambert"}, {}),
-    ("single", {"Base Color": (0.5, 0.5, 0.5, 1.0), "Roughness": 0.3},
-     {"specular": "single", "diffuse": "lambert"}, {}),
-)
+from rt_lookdev.addon import demo_scene
 
 
-def _principled(bpy, name, values):
-    mat = bpy.data.materials.new(name)
-    nodes = mat.node_tree.nodes
-    bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
-    for key, value in values.items():
-        bsdf.inputs[key].default_value = value
-    return mat
-
-
-def _sphere(bpy, name, location, material):
-    mesh = bpy.data.meshes.new(name)
-    import bmesh
-
-    bm = bmesh.new()
-    bmesh.ops.create_uvsphere(bm, u_segments=64, v_segments=32, radius=RADIUS)
-    bm.to_mesh(mesh)
-    bm.free()
-    for poly in mesh.polygons:
-        poly.use_smooth = True
-    mesh.materials.append(material)
-    obj = bpy.data.objects.new(name, mesh)
-    obj.location = location
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
-
-
-def _light(bpy, name, shape, size, size_y, power, location, rotation, color=(1.0, 1.0, 1.0)):
-    data = bpy.data.lights.new(name, "AREA")
-    data.shape = shape
-    data.size = size
-    data.size_y = size_y
-    data.energy = power
-    data.color = color
-    obj = bpy.data.objects.new(name, data)
-    obj.location = location
-    obj.rotation_euler = rotation
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
-
-
-DEFAULT_HDRI = "forest"
-WORLD_ROTATION_Z = 1.2          # radians, the Mapping node's Z rotation
-
-
-def add_hdri_world(bpy, scene, hdri, strength, rotation_z=WORLD_ROTATION_Z):
-    """World = Background(strength) <- Environment Texture(hdri) <- Mapping(rotation) <- Generated."""
-    from rt_lookdev.core.environment import equirect
-
-    world = bpy.data.worlds.new(f"HDRI {hdri}")
-    scene.world = world
-    nt = world.node_tree
-    nt.nodes.clear()
-    out = nt.nodes.new("ShaderNodeOutputWorld")
-    background = nt.nodes.new("ShaderNodeBackground")
-    background.inputs["Strength"].default_value = strength
-    env = nt.nodes.new("ShaderNodeTexEnvironment")
-    env.image = bpy.data.images.load(str(equirect.resolve_hdri(hdri)), check_existing=True)
-    mapping = nt.nodes.new("ShaderNodeMapping")
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
-    coords = nt.nodes.new("ShaderNodeTexCoord")
-    nt.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
-    nt.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
-    nt.links.new(env.outputs["Color"], background.inputs["Color"])
-    nt.links.new(background.outputs["Background"], out.inputs["Surface"])
-    # The RT Lit materials are emission only: Cycles needs no importance map of the world (building it
-    # cost ~0.8 s per demo render, measured) and the camera should not see it (a black background,
-    # as EEVEE's measurement world: scripts/demo_report.py compares the two).
-    world.cycles.sampling_method = "NONE"
-    world.cycles_visibility.camera = False
-    return world
-
-
-def build_demo_scene(lut_dir=None, resolution=256, hdri=DEFAULT_HDRI, world_strength=0.5):
-    """Build the scene in the current (emptied) file; returns {sphere name: features}.
-    ``hdri=None`` (or "none"): no world, so no World term."""
-    import bpy
-
-    from rt_lookdev.addon import convert, materials
-    from rt_lookdev.addon import world as rtl_world
-    from rt_lookdev.core.materials.rt_lit_interface import Features
-
-    bpy.ops.wm.read_homefile(use_empty=True)
-    scene = bpy.context.scene
-    scene.world = None
-    if hdri and hdri != "none":
-        add_hdri_world(bpy, scene, hdri, world_strength)
-    rtl_world.sync_world(scene)       # no usable image: no "RTL World" group, no World term
-
-    # lights first: the RT Lit groups are built for the scene's lights
-    _light(bpy, "Quad Key", "RECTANGLE", 2.0, 1.0, 600.0, (-2.0, -3.0, 2.5), (0.9, 0.0, -0.6),
-           (1.0, 0.95, 0.9))
-    _light(bpy, "Disk Fill", "DISK", 1.5, 1.5, 300.0, (3.0, -2.5, 0.5), (1.45, 0.0, 0.85), (0.8, 0.9, 1.0))
-    materials.sync_scene_lights(scene)
-
-    def factory(features):
-        return materials.ensure_rt_lit_group(features, scene, lut_dir)
-
-    spheres = {}
-    x0 = -0.5 * (len(ROUGHNESS) - 1) * SPACING
-    for row, (label, values, feats) in enumerate(ROWS):
-        for col, r in enumerate(ROUGHNESS):
-            name = f"{label} r{r:.2f}"
-            mat = _principled(bpy, name, dict(values, Roughness=r))
-            features = Features(**feats)
-            convert.principled_to_rt_lit(mat, factory, features)
-            _sphere(bpy, name, (x0 + col * SPACING, 0.0, (1 - row) * SPACING), mat)
-            spheres[name] = features
-    for col, (label, values, feats, rt_values) in enumerate(VARIANTS):
-        mat = _principled(bpy, label, values)
-        features = Features(**feats)
-        convert.principled_to_rt_lit(mat, factory, features)
-        group = mat.node_tree.nodes["RT Lit"]
-        for key, value in rt_values.items():
-            group.inputs[key].default_value = value
-        _sphere(bpy, label, (x0 + col * SPACING, 0.0, -SPACING), mat)
-        spheres[label] = features
-
-    cam_data = bpy.data.cameras.new("Demo Camera")
-    cam_data.type = "ORTHO"
-    cam_data.ortho_scale = SPACING * len(ROUGHNESS) + 0.2
-    cam = bpy.data.objects.new("Demo Camera", cam_data)
-    cam.location = (0.0, -10.0, 0.0)
-    cam.rotation_euler = (1.5707963267948966, 0.0, 0.0)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
-    r = scene.render
-    r.resolution_x = resolution
-    r.resolution_y = resolution          # square (256^2 by default): the rows sit in the middle
-    r.resolution_percentage = 100
-    return spheres
-
-
-def main(argv=None):
-    if argv is None:
-        argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=DEFAULT_OUT)
-    parser.add_argument("--lut-dir", type=Path, default=None)
-    parser.add_argument("--resolution", type=int, default=256)
-    parser.add_argument("--hdri", default=DEFAULT_HDRI, help="studio HDRI name or EXR path; 'none' for no world")
-    parser.add_argument("--world-strength", type=float, default=0.5)
-    args = parser.parse_args(argv)
-    import bpy
-
-    spheres = build_demo_scene(args.lut_dir, args.resolution, args.hdri, args.world_strength)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    bpy.ops.wm.save_as_mainfile(filepath=str(args.out.resolve()))
-    print(f"demo scene: {len(spheres)} RT Lit spheres, saved to {args.out}")
+def main(argv):
+    if "--" in argv:                      # blender --background --python x.py -- args
+        argv = argv[argv.index("--") + 1:]
+    demo_scene.run(demo_scene.parse_args(argv))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main(sys.argv[1:]))

@@ -1,7 +1,8 @@
 # shellcheck shell=bash
 # Source this file (the other scripts do): it makes sure <repo>/.venv exists with the
-# exact packages of requirements.lock, then puts .venv/bin first on PATH so that
-# `python` is the venv's CPython 3.11.
+# exact packages of requirements.lock and the checkout installed in editable mode as the
+# package ``rt_lookdev`` (pyproject.toml: how scripts and tests import it, no sys.path
+# edits), then puts .venv/bin first on PATH so that `python` is the venv's CPython 3.11.
 #
 #   RTL_PYTHON=/path/to/python3.11   use this interpreter to create the venv
 #
@@ -22,7 +23,7 @@ _rtl_env_setup() {
         echo "env.sh: $lock is missing" >&2
         return 2
     fi
-    want="$(sha256sum "$lock" | cut -d' ' -f1)"
+    want="$(cat "$lock" "$repo/pyproject.toml" | sha256sum | cut -d' ' -f1)"
 
     # Cached path: a 3.11 venv built from this exact lock file.  Stay quiet.
     if [[ -x "$venv/bin/python" && -f "$stamp" && "$(cat "$stamp")" == "$want" \
@@ -81,6 +82,12 @@ _rtl_env_setup() {
     if ! PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip install --no-deps --progress-bar off \
             -r "$lock"; then
         echo "env.sh: pip install -r requirements.lock failed (see above)" >&2
+        return 2
+    fi
+    echo "env.sh: installing this checkout in editable mode (the package rt_lookdev)"
+    if ! PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip install --no-deps --no-build-isolation \
+            --progress-bar off -q -e "$repo"; then
+        echo "env.sh: the editable install of $repo failed (see above)" >&2
         return 2
     fi
     if ! PIP_DISABLE_PIP_VERSION_CHECK=1 "$venv/bin/python" -m pip check; then

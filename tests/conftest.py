@@ -1,6 +1,6 @@
 """Shared pytest setup.
 
-- ``scripts/`` goes on sys.path and ``_bootstrap`` loads the repository as ``rt_lookdev``.
+- The repository is the package ``rt_lookdev`` (installed in editable mode by scripts/env.sh).
 - ``BLENDER_USER_RESOURCES`` points at a throw-away directory before anything can
   import bpy, so tests never read or write the developer's ~/.config/blender; baked world
   environments are cached in out/cache/environments (``RTL_ENVIRONMENT_CACHE``) unless set.
@@ -8,25 +8,16 @@
   (imports bpy once per session: it must never be re-imported) and ``empty_scene``.
 """
 import os
-import sys
 import tempfile
 from pathlib import Path
 
 import pytest
 
-SCRIPTS_DIR = Path(__file__).resolve().parents[1] / "scripts"
-sys.path.insert(0, str(SCRIPTS_DIR))
-
-import _bootstrap  # noqa: E402  (loads the package as ``rt_lookdev``)
-
+REPO = Path(__file__).resolve().parents[1]
 _USER_RESOURCES = tempfile.TemporaryDirectory(prefix="rtl-blender-user-")
 os.environ["BLENDER_USER_RESOURCES"] = _USER_RESOURCES.name
 # baked world environments (addon/world.py) go to the ignored out/ folder, not to ~/.cache
-os.environ.setdefault("RTL_ENVIRONMENT_CACHE", str(SCRIPTS_DIR.parent / "out" / "cache" / "environments"))
-
-
-def pytest_configure(config):
-    config.addinivalue_line("markers", "blender: needs the bpy module (Blender as a Python module)")
+os.environ.setdefault("RTL_ENVIRONMENT_CACHE", str(REPO / "out" / "cache" / "environments"))
 
 
 @pytest.fixture(scope="session")
@@ -46,7 +37,8 @@ def empty_scene(bpy_module):
 @pytest.fixture(scope="session")
 def lut_dir(tmp_path_factory):
     """The shipped LUT folder when it is current, else a fresh bake into a temp folder."""
-    from rt_lookdev.core.lut import bake, catalog
+    from rt_lookdev.core import lut_bake as bake
+    from rt_lookdev.core.lut import catalog
 
     shipped = catalog.default_lut_dir()
     if all(s.state == "ok" for s in catalog.lut_status(shipped)):
@@ -54,3 +46,11 @@ def lut_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("luts")
     bake.bake(out)
     return out
+
+
+@pytest.fixture(scope="session")
+def tables(lut_dir):
+    """The LUT set of ``lut_dir`` (``core.lut.lookup.LutSet``): what numpy evaluation and node groups read."""
+    from rt_lookdev.core.lut import lookup
+
+    return lookup.LutSet.from_folder(lut_dir)

@@ -65,7 +65,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..lut import exr_io
+from ..lut import catalog, exr_io
 from ..microfacet import ggx_distribution
 from ..sampling import hammersley_2d
 from . import equirect, sh
@@ -345,13 +345,14 @@ class EnvironmentBake:
 
 
 def inputs_hash(kind, source_hash, params):
-    """SHA-256 of the source image's content hash, the parameters and the code that computes the file."""
+    """SHA-256 of the source image's content hash, the parameters and the code that computes the file
+    (without comments and docstrings: ``core.lut.catalog.code_text``)."""
     hsh = hashlib.sha256()
     hsh.update(json.dumps({"kind": kind, "layout": LAYOUT_VERSION, "generator": GENERATOR_VERSION,
                            "source": source_hash, "params": params}, sort_keys=True).encode())
     for rel in _SOURCES:
         hsh.update(rel.encode())
-        hsh.update((_PACKAGE_ROOT / rel).read_bytes())
+        hsh.update(catalog.code_text(_PACKAGE_ROOT / rel).encode())
     return hsh.hexdigest()
 
 

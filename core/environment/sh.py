@@ -28,9 +28,6 @@ from . import equirect
 
 PI = math.pi
 
-# Ramamoorthi & Hanrahan 2001, eq. 3.
-from ..indirect import Y1, Y2_PRODUCT, Y00, Y20, Y22  # noqa: E402  (one set of constants: R&H 2001, eq. 3)
-
 #: Band l and order m of each coefficient.
 BAND = np.array([0, 1, 1, 1, 2, 2, 2, 2, 2])
 ORDER = np.array([0, -1, 0, 1, -2, -1, 0, 1, 2])

@@ -13,53 +13,23 @@ Kinds: "float" (Math node socket), "vector" (Vector Math socket).  Comparisons g
 """
 from __future__ import annotations
 
+import hashlib
 import itertools
-import threading
 
 import numpy as np
 
-FLOAT, VECTOR = "float", "vector"
-CALL = "call"   # the kind of a function-call node; its outputs are "output" nodes
+from .semantics import CALL, FLOAT, LEAVES, OPERATIONS, TABLE_READS, VECTOR, apply
 
-#: operation -> (argument kinds, result kind).  "vector?"-free: every operation has fixed kinds.
-OPS = {
-    "const": ((), FLOAT), "input": ((), FLOAT), "vconst": ((), VECTOR), "vinput": ((), VECTOR),
-    # Math node (ShaderNodeMath)
-    "add": ((FLOAT, FLOAT), FLOAT), "subtract": ((FLOAT, FLOAT), FLOAT),
-    "multiply": ((FLOAT, FLOAT), FLOAT), "divide": ((FLOAT, FLOAT), FLOAT),
-    "power": ((FLOAT, FLOAT), FLOAT), "sqrt": ((FLOAT,), FLOAT), "inverse_sqrt": ((FLOAT,), FLOAT),
-    "exponent": ((FLOAT,), FLOAT), "log2": ((FLOAT,), FLOAT),
-    "minimum": ((FLOAT, FLOAT), FLOAT), "maximum": ((FLOAT, FLOAT), FLOAT),
-    "less_than": ((FLOAT, FLOAT), FLOAT), "greater_than": ((FLOAT, FLOAT), FLOAT),
-    "absolute": ((FLOAT,), FLOAT), "floor": ((FLOAT,), FLOAT),
-    "arccosine": ((FLOAT,), FLOAT), "arcsine": ((FLOAT,), FLOAT),
-    "sine": ((FLOAT,), FLOAT), "cosine": ((FLOAT,), FLOAT), "tangent": ((FLOAT,), FLOAT),
-    "arctan2": ((FLOAT, FLOAT), FLOAT),
-    # Mix node with a float factor: select(c, a, b) = mix(b, a, c) for c in {0, 1}
-    "select": ((FLOAT, FLOAT, FLOAT), FLOAT),
-    "vselect": ((FLOAT, VECTOR, VECTOR), VECTOR),
-    # Image Texture (Linear, EXTEND) at (u, v), one channel: attrs ("table", name), ("channel", 0..3)
-    "lut": ((FLOAT, FLOAT), FLOAT),
-    # Image Texture (Closest, EXTEND) at (u, v): the texel (floor(u W), floor(v H)), one channel
-    "texel": ((FLOAT, FLOAT), FLOAT),
-    # Combine / Separate XYZ
-    "combine": ((FLOAT, FLOAT, FLOAT), VECTOR), "x": ((VECTOR,), FLOAT), "y": ((VECTOR,), FLOAT),
-    "z": ((VECTOR,), FLOAT),
-    # Vector Math node (ShaderNodeVectorMath)
-    "vadd": ((VECTOR, VECTOR), VECTOR), "vsubtract": ((VECTOR, VECTOR), VECTOR),
-    "vscale": ((VECTOR, FLOAT), VECTOR), "vmultiply": ((VECTOR, VECTOR), VECTOR),
-    "dot": ((VECTOR, VECTOR), FLOAT),
-    "cross": ((VECTOR, VECTOR), VECTOR), "length": ((VECTOR,), FLOAT), "normalize": ((VECTOR,), VECTOR),
-}
+#: operation -> (argument kinds, result kind), from the one table of semantics (``semantics``).
+OPS = {name: (operation.args, operation.result) for name, operation in OPERATIONS.items()}
 
-_local = threading.local()
 _FOLDING = {"enabled": True}
 
 
 class folding:
     """``with folding(False):`` traces without constant folding, identities or dead-branch
-    removal (hash-consing stays): for measuring what folding saves.  Traced node-function bodies
-    are cached, so callers invalidate them around the block (``functions.invalidate_all``)."""
+    removal (hash-consing stays): for measuring what folding saves.  Node functions keep one traced
+    body per setting (``functions.NodeFunction.function``)."""
 
     def __init__(self, enabled):
         self.enabled, self.previous = bool(enabled), None
@@ -74,12 +44,16 @@ class folding:
         return False
 
 
+def folding_enabled():
+    return _FOLDING["enabled"]
+
+
 class Graph:
     """Interns expressions; one graph per traced function."""
 
     def __init__(self):
         self.nodes = {}
-        self.luts = {}          # table name -> (H, W, 4) array, for the numpy backend
+        self.tables = {}        # table name -> tables.Table (a reference: the data is the caller's)
         self.functions = {}     # Function.key -> Function called from this graph
         self._ids = itertools.count()
 
@@ -132,6 +106,17 @@ class Graph:
             node = Expr(self, next(self._ids), op, args, attrs, result)
             self.nodes[key] = node
         return node
+
+    def read_table(self, table, u, v, channel, op="texel"):
+        """Channel ``channel`` of ``table`` (a ``tables.Table``) at (u, v): a ``texel`` (Closest) or
+        ``lut`` (Linear) node naming the table; the graph keeps only its reference."""
+        if op not in TABLE_READS:
+            raise ValueError(f"{op!r} does not read a table")
+        known = self.tables.get(table.name)
+        if known is not None and known.shape != table.shape:
+            raise ValueError(f"table {table.name!r} read with sizes {known.shape} and {table.shape}")
+        self.tables.setdefault(table.name, table.reference())
+        return self.make(op, (u, v), (("table", table.name), ("channel", int(channel))))
 
     def const(self, value):
         return self.make("const", attrs=(("value", float(np.float32(value))),))
@@ -266,11 +251,24 @@ def define(name, fn, inputs, description="", sockets=None):
     return Function(name, inputs, out, description, sockets)
 
 
+def topological_order(outputs):
+    """Nodes reachable from ``outputs``, each after its arguments (iterative DFS)."""
+    order, seen = [], set()
+    stack = [(o, False) for o in reversed(outputs)]
+    while stack:
+        node, expanded = stack.pop()
+        if node.id in seen:
+            continue
+        if expanded:
+            seen.add(node.id)
+            order.append(node)
+            continue
+        stack.append((node, True))
+        stack.extend((a, False) for a in reversed(node.args) if a.id not in seen)
+    return order
+
+
 def _structure_hash(function):
-    import hashlib
-
-    from .numpy_backend import topological_order
-
     index = {}
     parts = [repr(function.inputs), repr([(k, e.kind) for k, e in function.outputs.items()])]
     for node in topological_order(list(function.outputs.values())):
@@ -288,12 +286,10 @@ def _const_value(e):
 
 def _simplify(graph, op, args):
     """Constant folding and algebraic identities that hold under Blender's semantics."""
-    if op in ("const", "vconst", "input", "vinput", "lut", "texel"):
+    if op in LEAVES or op in TABLE_READS:
         return None
     if all(a.is_const for a in args):
-        from .numpy_backend import apply_op
-
-        value = apply_op(op, [np.asarray(_const_value(a), dtype=np.float32) for a in args], ())
+        value = apply(op, [np.asarray(_const_value(a), dtype=np.float32) for a in args])
         return graph.vconst(value) if OPS[op][1] == VECTOR else graph.const(value)
     if op in ("select", "vselect") and args[0].is_const:
         return args[1] if _const_value(args[0]) != 0.0 else args[2]

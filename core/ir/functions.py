@@ -1,42 +1,38 @@
 """Shading functions that are also node groups.
 
-``NodeFunction`` wraps a Python shading function written with ``core.shading_ops``.  Called
-with numpy arrays it simply runs; called with any ``Expr`` argument it becomes one ``call``
-node of the caller's graph, whose body is the function traced once (``expr.define``) and
-shared by every call.  So the same source gives direct numpy evaluation, the IR's numpy
-evaluation, and nested Blender node groups (one group per function, instanced at each call).
+``NodeFunction`` wraps a Python shading function written with ``core.shading_ops``.  Called with
+numpy arrays it simply runs; called with any ``Expr`` argument it becomes one ``call`` node of the
+caller's graph, whose body is the function traced once (``expr.define``) and shared by every call.
+So the same source gives direct numpy evaluation, the IR's numpy evaluation, and nested Blender
+node groups (one group per function, instanced at each call).
+
+A function that reads tables is declared with ``tables=``: the table set it is traced with, whose
+entries are references (name and size, no data; ``core.lut.lookup.REFERENCES``).  Its Python body
+takes the table set as its first argument: traced, it receives those references, so the traced body
+does not depend on any folder of tables; called with numpy arrays, it receives the table set the
+caller passes (``fn(tables=..., **inputs)``), which holds the data.
 """
 from __future__ import annotations
 
-import weakref
-
-from .expr import FLOAT, VECTOR, define, graph_of, is_expr
-
-_ALL = weakref.WeakSet()
-
-
-def invalidate_all():
-    """Forget every traced body (e.g. after the LUT folder changed: bodies hold table data)."""
-    for fn in list(_ALL):
-        fn.invalidate()
+from .expr import FLOAT, VECTOR, define, folding_enabled, graph_of, is_expr
 
 _KIND = {"float": FLOAT, "vector": VECTOR, "color": VECTOR}
 
 
 class NodeFunction:
-    """``fn(**inputs) -> dict`` of named outputs, with ``sockets`` (name -> interface.Socket) in
-    interface order: inputs first, then outputs (``outputs`` lists their names)."""
+    """``fn(**inputs) -> dict`` of named outputs (``fn(tables, **inputs)`` when ``tables`` is given),
+    with ``sockets`` (name -> interface.Socket) in interface order: inputs first, then outputs."""
 
-    def __init__(self, name, fn, inputs, outputs, description=""):
+    def __init__(self, name, fn, inputs, outputs, description="", tables=None):
         self.name, self.fn, self.description = name, fn, description
         self.input_sockets = dict(inputs)
         self.output_sockets = dict(outputs)
-        self._function = None
-        _ALL.add(self)
+        self.trace_tables = tables
+        self._functions = {}        # folding on/off -> traced body
 
-    def invalidate(self):
-        """Trace the body again on next use."""
-        self._function = None
+    @property
+    def reads_tables(self):
+        return self.trace_tables is not None
 
     @property
     def input_kinds(self):
@@ -44,27 +40,33 @@ class NodeFunction:
 
     @property
     def function(self):
-        """The traced body (``expr.Function``), built on first use."""
-        if self._function is None:
+        """The traced body (``expr.Function``), built on first use (once with constant folding, once
+        without: ``expr.folding``)."""
+        folded = folding_enabled()
+        if folded not in self._functions:
             sockets = (self.input_sockets, self.output_sockets)
-            fn = self.fn
 
             def body(**kw):
-                out = fn(**kw)
+                out = self._run(self.trace_tables, kw)
                 missing = set(self.output_sockets) - set(out)
                 if missing:
                     raise ValueError(f"{self.name} did not return {sorted(missing)}")
                 return {k: out[k] for k in self.output_sockets}
 
-            self._function = define(self.name, body, self.input_kinds, self.description, sockets)
-        return self._function
+            self._functions[folded] = define(self.name, body, self.input_kinds, self.description, sockets)
+        return self._functions[folded]
 
-    def __call__(self, **args):
+    def _run(self, tables, args):
+        return self.fn(tables, **args) if self.reads_tables else self.fn(**args)
+
+    def __call__(self, tables=None, **args):
         if set(args) != set(self.input_sockets):
             raise ValueError(f"{self.name}: expected inputs {sorted(self.input_sockets)}, got {sorted(args)}")
         if is_expr(*args.values()):
             return graph_of(*args.values()).call(self.function, args)
-        return self.fn(**args)
+        if self.reads_tables and tables is None:
+            raise TypeError(f"{self.name} reads tables: pass tables= (e.g. core.lut.lookup.LutSet.from_folder())")
+        return self._run(tables, args)
 
     def __repr__(self):
         return f"NodeFunction<{self.name}>"

@@ -10,7 +10,7 @@
 
 Local frame: N = +Z; the view vector lies in the XZ plane, V = (sin theta, 0, cos theta).
 Tables store the inverse matrix normalised so that Minv[1][1] = 1 with four free entries
-(the layout of selfshadow/ltc_code, ../shared/reference/ltc.md §1.4):
+(the layout of selfshadow/ltc_code, docs/area_lights.md, "Table layout"):
     Minv = [[c0, 0, c2],
             [0,  1, 0 ],
             [c1, 0, c3]]

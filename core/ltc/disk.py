@@ -1,10 +1,11 @@
 """Integral of an LTC over a disk / ellipse light.
 
 Heitz & Hill 2017, "Real-Time Line- and Disk-Light Shading with Linearly Transformed Cosines"
-(SIGGRAPH course "Physically Based Shading in Theory and Practice"; ltc_code ``ltc_disk.fs``,
-ltc.md §1.6): a linear map takes an ellipse to an ellipse, so the transformed light is the
-ellipse (C, V1, V2) seen from the origin.  The cone through it is a quadric with one negative
-eigenvalue e2 (its axis) and two positive ones e1, e3; the cone is also the cone of a
+(SIGGRAPH course "Physically Based Shading in Theory and Practice"; ltc_code ``ltc_disk.fs``;
+docs/area_lights.md, "Disk and ellipse lights"): a linear map takes an ellipse to an ellipse, so
+the transformed light is the ellipse (C, V1, V2) seen from the origin.  The cone through it is a
+quadric with one negative eigenvalue e2 (its axis) and two positive ones e1, e3; the cone is
+also the cone of a
 "front-facing" ellipse centred on the axis at unit distance with extents L1 = sqrt(-e2/e3),
 L2 = sqrt(-e2/e1), whose form factor is L1 L2 / sqrt((1 + L1^2)(1 + L2^2)) and whose vector
 form factor points along the axis.  The horizon is handled as for polygons, by the sphere
@@ -31,7 +32,8 @@ other coefficient (Binet-Cauchy identity), from cross products the coefficients 
 
 Robustness (float32 and shader nodes):
 - the light is first scaled by 1/(|C| + |V1| + |V2|) (the cone is scale invariant), which
-  bounds every root by 1, generalising EEVEE's "rescale the cubic for small lights" (ltc.md §2.2);
+  bounds every root by 1, generalising EEVEE's "rescale the cubic for small lights"
+  (docs/area_lights.md, "EEVEE's LTC code");
 - the negative root comes from Viete's formula with its acos argument clamped (the fix of
   ltc_code#9 / Blender #67060) and, when it is not the root of largest magnitude, from the
   quadratic left after dividing out the largest root (``negative_root``): small lights give a
@@ -153,7 +155,7 @@ def ltc_disk_integral(minv, center, axis_u, axis_v, two_sided=False, sphere_tabl
     return np.asarray(value).astype(center.dtype, copy=False)
 
 
-# --- equal-area regular N-gon fallback (ltc.md §4.2, §5.1) -------------------------------------
+# --- equal-area regular N-gon fallback (docs/area_lights.md, "Disk and ellipse lights") ---------
 
 def disk_polygon(center, axis_u, axis_v, n=8):
     """Vertices (..., n, 3) of the affine image of the regular n-gon with the disk's area:
@@ -175,11 +177,10 @@ def ltc_disk_integral_polygon(minv, center, axis_u, axis_v, n=8, two_sided=False
 
 # --- the node function -------------------------------------------------------------------------
 
-def _disk_integral_node(**inputs):
+def _disk_integral_node(tables, **inputs):
     c = tuple(inputs[f"c{i}"] for i in range(4))
-    sphere = lookup.default_ltc_tables().sphere_table()
     return {"Integral": ltc_disk_integral_packed(c, inputs["Center"], inputs["Axis U"], inputs["Axis V"],
-                                                 inputs["Two Sided"], sphere)}
+                                                 inputs["Two Sided"], tables.sphere_table())}
 
 
 #: Integral of an LTC over a disk / ellipse light (Heitz & Hill 2017): one node group.
@@ -196,5 +197,6 @@ LTC_DISK_INTEGRAL = NodeFunction(
     outputs={"Integral": Socket("float", 0.0, 0.0, 1.0, "FACTOR",
                                 "Integral of the normalised LTC over the disk, horizon-clipped (sphere table): "
                                 "multiply by the lobe's magnitude")},
-    description="LTC integral over a disk or ellipse light (Heitz & Hill 2017 closed form)")
+    description="LTC integral over a disk or ellipse light (Heitz & Hill 2017 closed form)",
+    tables=lookup.REFERENCES)
 

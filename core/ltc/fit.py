@@ -1,4 +1,4 @@
-"""Fit LTC tables to BRDF x cos lobes (Heitz et al. 2016, section 4; ltc.md §1.2 and §5.2).
+"""Fit LTC tables to BRDF x cos lobes (Heitz et al. 2016, section 4; docs/area_lights.md, "Fitting").
 
 For every cell (view cosine mu, roughness r) of the table:
 1. magnitude, Fresnel and average direction of the lobe by importance sampling over a 2D
@@ -10,9 +10,9 @@ For every cell (view cosine mu, roughness r) of the table:
    own sampling, from the starting LTC, and uniformly over the sphere, weighted by the inverse
    of the mixture density.
 
-Differences from ltc_code (ltc.md §1.2): the four entries of Minv are fitted directly (ltc_code
-fits three in the frame of the average direction, then zeroes couplings), which can only
-lower the error; all roughness values of a view row are solved together with a batched
+Differences from ltc_code (docs/area_lights.md, "Fitting"): the four entries of Minv are fitted
+directly (ltc_code fits three in the frame of the average direction, then zeroes couplings),
+which can only lower the error; all roughness values of a view row are solved together with a batched
 Nelder-Mead; each row starts from the better of the previous row's matrix and that matrix
 rotated with the average direction; the first row (normal incidence) is isotropic,
 Minv = diag(1, 1, c3), found by a grid search and refined.
@@ -23,7 +23,7 @@ import numpy as np
 
 from .. import sampling
 from . import matrix, optimize
-from .lobes import LOBES
+from .fit_lobes import LOBES
 
 #: Smallest view cosine fitted (theta <= 89.94 deg); the last table row (mu = 0) uses it.
 FIT_MU_MIN = 1e-3

@@ -27,7 +27,8 @@ def unpack_inverse(c):
     return m
 
 
-# Heitz et al. 2016 (ltc_code's table layout, ltc.md §1.4): Minv = [[c0, 0, c2], [0, 1, 0], [c1, 0, c3]].
+# Heitz et al. 2016 (ltc_code's table layout, docs/area_lights.md, "Table layout"):
+# Minv = [[c0, 0, c2], [0, 1, 0], [c1, 0, c3]].
 def transform_packed(c, point):
     """Minv applied to a point (a (..., 3) array or an Expr vector) for packed entries c = (c0, c1, c2, c3):
     (c0 x + c2 z, y, c1 x + c3 z), written as two dot products with the rows (c0, 0, c2) and

@@ -7,10 +7,10 @@ the polygon transformed by Minv (eq. 11), which is Lambert's form factor of that
 the vector form factor F = 1/(2 pi) sum_i theta_i n_i over the edges).
 
 Two evaluation methods:
-- ``"clipless"`` (Hill & Heitz 2017, ltc_code ``ltc_quad.fs``; ltc.md §1.5, §5.1): the vector
-  form factor of the unclipped polygon with the rational fit of theta/sin(theta), and the
-  horizon handled by the sphere table (``sphere_table.clipped_sphere_integral``).  Branch-free,
-  the formulation for shader nodes.
+- ``"clipless"`` (Hill & Heitz 2017, ltc_code ``ltc_quad.fs``; docs/area_lights.md, "Clipless
+  evaluation"): the vector form factor of the unclipped polygon with the rational fit of
+  theta/sin(theta), and the horizon handled by the sphere table
+  (``sphere_table.clipped_sphere_integral``).  Branch-free, the formulation for shader nodes.
 - ``"clipped"``: exact clipping of the transformed polygon to the upper hemisphere and the exact
   edge integral; the reference that tests compare the clipless path with.
 
@@ -46,7 +46,8 @@ from . import sphere_table as spheres
 
 _INV_2PI = 0.5 / np.pi
 
-#: EEVEE ``ltc_tangent_basis`` treats N.V > 0.999999 as normal incidence (ltc.md §2.2): sin^2 < 2e-6.
+#: EEVEE ``ltc_tangent_basis`` treats N.V > 0.999999 as normal incidence: sin^2 < 2e-6
+#: (docs/area_lights.md, "EEVEE's LTC code").
 FRAME_SIN2_MIN = 2e-6
 
 #: Floor for sin^2(theta) in the x < 0 branch of the edge fit.  It only prevents 0 * inf: the
@@ -97,7 +98,8 @@ def _any_tangent(n):
     return op.vec3(1.0 + s * nx * nx * a, s * nx * ny * a, -s * nx)
 
 
-# Heitz et al. 2016 / ltc_code ``ltc_quad.fs`` (ltc.md §1.5): T1 = normalize(V - N (V.N)), T2 = N x T1.
+# Heitz et al. 2016 / ltc_code ``ltc_quad.fs`` (docs/area_lights.md, "Clipless evaluation"):
+# T1 = normalize(V - N (V.N)), T2 = N x T1.
 def local_frame(n, v):
     """Orthonormal (T1, T2, N) for unit normal n and view v (vectors); T1 falls back to any tangent
     when V is parallel to N (then the LTC is isotropic and the choice does not matter)."""
@@ -131,7 +133,8 @@ def transform(minv, points):
 
 # --- edge integrals ----------------------------------------------------------------------------
 
-# Hill & Heitz 2017 (ltc_code 7c1fa5f ``IntegrateEdgeVec``; ltc.md §1.5): rational fit of
+# Hill & Heitz 2017 (ltc_code 7c1fa5f ``IntegrateEdgeVec``; docs/area_lights.md, "Clipless
+# evaluation"): rational fit of
 # theta / sin(theta) / (2 pi) in y = |x|, x = cos(theta) (max relative error 1.4e-6); for x < 0
 # the symmetry theta -> pi - theta gives 1/(2 sin(theta)) - fit(|x|).
 # One departure: ltc_code forms sin^2 = max(1 - x^2, 1e-7) (b23b090), which cancels near
@@ -255,12 +258,13 @@ def _as_float(minv, corners):
     return np.asarray(minv, dtype=dtype), np.asarray(corners, dtype=dtype)
 
 
-# Hill & Heitz 2017 (ltc_code ``ltc_quad.fs``, clipless branch; ltc.md §1.5): |F| and z = F.z/|F|;
+# Hill & Heitz 2017 (ltc_code ``ltc_quad.fs``, clipless branch; docs/area_lights.md, "Clipless
+# evaluation"): |F| and z = F.z/|F|;
 # behind the light z flips (two-sided) or the light is dark (one-sided); horizon from the sphere table.
 def polygon_integral_clipless(points, two_sided, sphere_table=None):
     """Clipless integral of the clamped cosine over a polygon already transformed by Minv (K vectors,
     a sequence or an (..., K, 3) array).  ``two_sided``: bool or 0/1 (an Expr when traced);
-    ``sphere_table``: see ``sphere_table.clipped_sphere_integral`` (an op.Lut when traced)."""
+    ``sphere_table``: see ``sphere_table.clipped_sphere_integral`` (a Table when traced)."""
     pts = _vectors(points)
     f = vector_form_factor([op.normalize(q) for q in pts])
     length = op.length(f)
@@ -290,7 +294,7 @@ def _integral_clipped(transformed, two_sided):
 def ltc_polygon_integral(minv, corners, two_sided=False, sphere_table=None, method="clipless"):
     """Integral of the normalised LTC ``minv`` (..., 3, 3) over the polygon ``corners`` (..., K, 3)
     (local frame, relative to the shading point, ordered as in the module docstring); numpy.
-    ``sphere_table``: None (the analytic table), an (H, W) table or an op.Lut."""
+    ``sphere_table``: None (the analytic table), an (H, W) table or a Table."""
     minv, corners = _as_float(minv, corners)
     transformed = transform(minv, corners)
     if method == "clipless":
@@ -318,11 +322,10 @@ def ltc_polygon_vector_form_factor(minv, corners):
 
 # --- the node function -------------------------------------------------------------------------
 
-def _quad_integral_node(**inputs):
+def _quad_integral_node(tables, **inputs):
     c = tuple(inputs[f"c{i}"] for i in range(4))
     corners = [inputs[f"p{i}"] for i in range(4)]
-    sphere = lookup.default_ltc_tables().sphere_table()
-    return {"Integral": ltc_polygon_integral_packed(c, corners, inputs["Two Sided"], sphere)}
+    return {"Integral": ltc_polygon_integral_packed(c, corners, inputs["Two Sided"], tables.sphere_table())}
 
 
 _C_TIPS = {"c0": "Minv[0][0] (R of the LTC matrix table)", "c1": "Minv[2][0] (G of the LTC matrix table)",
@@ -345,5 +348,6 @@ LTC_QUAD_INTEGRAL = NodeFunction(
     outputs={"Integral": Socket("float", 0.0, 0.0, 1.0, "FACTOR",
                                 "Integral of the normalised LTC over the light, horizon-clipped (sphere table): "
                                 "multiply by the lobe's magnitude")},
-    description="LTC integral over a quad light (Heitz et al. 2016, clipless form of Hill & Heitz 2017)")
+    description="LTC integral over a quad light (Heitz et al. 2016, clipless form of Hill & Heitz 2017)",
+    tables=lookup.REFERENCES)
 

@@ -3,15 +3,15 @@
 Every function returns outgoing radiance per unit emitted radiance of the light (multiply by
 the light's radiance).  Geometry is world-space: shading point ``p``, unit normal ``n``, unit
 view ``v`` (towards the eye), and a light built with ``QuadLight`` or ``DiskLight``; ``tables``
-is a ``core.lut.lookup.LtcTables``.  Written with ``core.shading_ops`` only: called with numpy
+is a ``core.lut.lookup.LutSet`` (holding data for numpy, ``lookup.REFERENCES`` when traced).  Written with ``core.shading_ops`` only: called with numpy
 arrays (vectors = (..., 3) arrays, vectorised over shading points) it computes; called with
 ``core.ir.Expr`` inputs (``core.ir.trace``) it builds the node graph, where the LTC table
 lookups are ``lut`` nodes and each light integral is one call of ``polygon.LTC_QUAD_INTEGRAL`` /
 ``disk.LTC_DISK_INTEGRAL`` (a nested node group).  The local frame is computed once per
 (n, v) when traced (hash-consing shares it between lobes).
 
-The integrals read the sphere table from ``lookup.default_ltc_tables()`` (``ltc_ggx_mag``,
-channel A: the same table in every LUT folder); ``tables`` gives the lobes' own tables.
+The integrals read the sphere table from the same ``tables`` (``ltc_ggx_mag``, channel A: the same
+table in every LUT folder).
 """
 from __future__ import annotations
 
@@ -48,13 +48,13 @@ class QuadLight:
     def center(self):
         return op.scale(functools.reduce(operator.add, self.corner_list()), 0.25)
 
-    def integral(self, c, frame, p):
+    def integral(self, tables, c, frame, p):
         """LTC integral for packed Minv entries c in the shading frame ``frame`` (``polygon.local_frame``)."""
         local = [polygon.frame_coordinates(frame, q - p) for q in self.corner_list()]
         args = {f"c{i}": c[i] for i in range(4)}
         args.update({f"p{i}": local[i] for i in range(4)})
         args["Two Sided"] = self.two_sided
-        return polygon.LTC_QUAD_INTEGRAL(**args)["Integral"]
+        return polygon.LTC_QUAD_INTEGRAL(tables, **args)["Integral"]
 
 
 @dataclass(frozen=True)
@@ -66,20 +66,20 @@ class DiskLight:
     axis_v: object
     two_sided: object = False
 
-    def integral(self, c, frame, p):
+    def integral(self, tables, c, frame, p):
         args = {f"c{i}": c[i] for i in range(4)}
         args.update({"Center": polygon.frame_coordinates(frame, self.center - p),
                      "Axis U": polygon.frame_coordinates(frame, self.axis_u),
                      "Axis V": polygon.frame_coordinates(frame, self.axis_v),
                      "Two Sided": self.two_sided})
-        return disk.LTC_DISK_INTEGRAL(**args)["Integral"]
+        return disk.LTC_DISK_INTEGRAL(tables, **args)["Integral"]
 
 
 def lobe_integral(tables, prefix, light, p, n, v, roughness):
     """(LTC integral, magnitude, fresnel) of one table's lobe at this shading point."""
     mu = op.saturate(op.dot(n, v))
-    packed, magnitude, fresnel = tables.lookup(prefix, mu, roughness)
-    value = light.integral(packed, polygon.local_frame(n, v), p)
+    packed, magnitude, fresnel = tables.ltc(prefix, mu, roughness)
+    value = light.integral(tables, packed, polygon.local_frame(n, v), p)
     return value, magnitude, fresnel
 
 
@@ -123,9 +123,9 @@ def disney_sheen(tables, light, p, n, v, sheen_color):
 
 
 def lambert(tables, light, p, n, v, albedo):
-    """Lambert: the identity LTC gives the exact form factor (Heitz et al. 2016, section 5).
-    ``tables`` is unused (kept for a uniform signature)."""
-    return light.integral(IDENTITY, polygon.local_frame(n, v), p) * albedo
+    """Lambert: the identity LTC gives the exact form factor (Heitz et al. 2016, section 5); ``tables``
+    supplies only the sphere table."""
+    return light.integral(tables, IDENTITY, polygon.local_frame(n, v), p) * albedo
 
 
 def light_center(light):

@@ -1,9 +1,10 @@
 """Horizon-clipped form factor of a spherical cap, and its table (the LTC "sphere table").
 
-The clipless LTC evaluation (Hill & Heitz 2016/2017; ltc.md §1.5) replaces a polygon or a
-disk by the spherical cap with the same vector form factor F: |F| = sin^2(sigma) (sigma =
-cap half-angle) and the cap axis along F.  The light's horizon-clipped form factor is then
-approximated by the cap's, which is known in closed form (Snyder 1996).
+The clipless LTC evaluation (Hill & Heitz 2016/2017; docs/area_lights.md, "Clipless evaluation")
+replaces a polygon or a disk by the spherical cap with the same vector form factor F:
+|F| = sin^2(sigma) (sigma = cap half-angle) and the cap axis along F.  The light's
+horizon-clipped form factor is then approximated by the cap's, which is known in closed form
+(Snyder 1996).
 
 Table layout (stored in the spare channel A of every ``*_mag`` LTC table): ``table[j, i]``
 with the z axis along i (texture u) and the |F| axis along j (texture v):
@@ -11,7 +12,7 @@ with the z axis along i (texture u) and the |F| axis along j (texture v):
     value = clipped_form_factor(z, len) / len in [0, 1], and max(z, 0) at len = 0.
 A shader reads it at u = lut_coordinate(z/2 + 1/2), v = lut_coordinate(|F|) and multiplies
 by |F| (``clipped_sphere_integral``).  Traced shader code reads channel A of the ``ltc_ggx_mag``
-image (``core.lut.lookup.default_ltc_tables().sphere_table()``, an ``op.Lut``); numpy callers may
+table (``core.lut.lookup.LutSet.sphere_table()``, a ``core.ir.tables.Table``); numpy callers may
 also pass a bare (H, W) table, or nothing for the analytic table of ``default_table``.
 """
 from __future__ import annotations
@@ -22,11 +23,12 @@ import numpy as np
 
 from .. import shading_ops as op
 from ..ir.expr import is_expr
+from ..ir.tables import Table
 
 #: Channel of a ``*_mag`` LTC table that holds the sphere table (docs/luts.md).
 SPHERE_CHANNEL = 3
 
-#: Default table size (64 x 64, the LTC tables' size, ltc.md §5.2).
+#: Default table size (64 x 64, the LTC tables' size, docs/area_lights.md, "Table layout").
 SIZE = 64
 
 
@@ -78,29 +80,30 @@ def default_table(size=SIZE):
 
 
 def _sphere_lut(table, traced):
-    """(Lut, channel) for a sphere table given as a Lut (channel A of a ``*_mag`` table), an (H, W)
+    """(Table, channel) for a sphere table given as a Table (channel A of a ``*_mag`` table), an (H, W)
     array, or None (the analytic table; numpy only)."""
-    if isinstance(table, op.Lut):
+    if isinstance(table, Table):
         return table, SPHERE_CHANNEL
     if traced:
-        raise TypeError("traced code reads the sphere table from an image: pass an op.Lut "
-                        "(core.lut.lookup.default_ltc_tables().sphere_table())")
+        raise TypeError("traced code reads the sphere table from an image: pass its Table "
+                        "(core.lut.lookup.LutSet.sphere_table())")
     table = default_table() if table is None else np.asarray(table)
     if table.ndim == 3:
-        return op.Lut("sphere_table", table), SPHERE_CHANNEL
-    return op.Lut("sphere_table", table[..., None]), 0
+        return Table.from_array("sphere_table", table), SPHERE_CHANNEL
+    return Table.from_array("sphere_table", table[..., None]), 0
 
 
-# Hill & Heitz 2016/2017 (ltc_code ``ltc_quad.fs``, ltc.md §1.5): clipped integral of a light with
+# Hill & Heitz 2016/2017 (ltc_code ``ltc_quad.fs``; docs/area_lights.md, "Clipless evaluation"):
+# clipped integral of a light with
 # vector form factor F ~ |F| * table(z/2 + 1/2, |F|), z = F.z / |F|, bilinear at texel centres.
 # The coordinates are lut_coordinate's (x (N - 1) + 0.5) / N folded into one multiply-add each,
 # without its clamp to [0, 1]: EXTEND clamps to the edge texels, which is the same lookup.
 def clipped_sphere_integral(length, z, table=None):
     """|F| times the table's ratio at (z, |F|): the horizon-clipped form factor of the equivalent cap.
-    ``length``, ``z`` arrays or Exprs; ``table`` as in ``_sphere_lut`` (a Lut when traced)."""
+    ``length``, ``z`` arrays or Exprs; ``table`` as in ``_sphere_lut`` (a Table when traced)."""
     traced = is_expr(length, z)
     lut, channel = _sphere_lut(table, traced)
-    size_v, size_u = lut.table.shape[:2]
+    size_v, size_u = lut.shape
     u = z * (0.5 * (size_u - 1) / size_u) + 0.5
     v = length * ((size_v - 1) / size_v) + 0.5 / size_v
     value = length * op.lut_sample(lut, u, v, channel)

@@ -12,8 +12,11 @@ with bilinear filtering and EXTEND, which reconstructs the piecewise-linear tabl
 """
 from __future__ import annotations
 
+import ast
 import hashlib
+import io
 import json
+import tokenize
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -69,7 +72,7 @@ GROUPS = {
         params={"size": ENERGY_SIZE, "samples": ENERGY_SAMPLES, "sampler": "hammersley-2d+ggx-vndf",
                 "mu_min": 1e-4},
         sources=("core/energy.py", "core/microfacet.py", "core/sampling.py", "core/conventions.py",
-                 "core/shading_ops.py", "core/lut/bake.py"),
+                 "core/shading_ops.py", "core/ir/semantics.py", "core/lut_bake.py"),
     ),
 }
 
@@ -79,11 +82,12 @@ LTC_SIZE = 64
 LTC_FIT = {"size": LTC_SIZE, "moment_samples": 1 << 14, "fit_samples": [384, 384, 96], "exponent": 1.0,
            "max_iter": 300, "fit_mu_min": 1e-3}
 
-_LTC_SOURCES = ("core/ltc/fit.py", "core/ltc/lobes.py", "core/ltc/matrix.py", "core/ltc/optimize.py",
+_LTC_SOURCES = ("core/ltc/fit.py", "core/ltc/fit_lobes.py", "core/ltc/matrix.py", "core/ltc/optimize.py",
                 "core/ltc/sphere_table.py", "core/microfacet.py", "core/diffuse.py", "core/cloth.py",
-                "core/sampling.py", "core/conventions.py", "core/shading_ops.py", "core/lut/bake.py")
+                "core/sampling.py", "core/conventions.py", "core/shading_ops.py", "core/ir/semantics.py",
+                "core/lut_bake.py")
 
-#: LTC lobes: table prefix -> (lobe name in core.ltc.lobes, description)
+#: LTC lobes: table prefix -> (lobe name in core.ltc.fit_lobes, description)
 LTC_LOBES = {
     "ltc_ggx": ("ggx", "single-scattering GGX (F = 1, height-correlated Smith G2)"),
     "ltc_cod_diffuse": ("cod_diffuse", "Call of Duty WWII multiscattering diffuse (albedo 1)"),
@@ -141,8 +145,38 @@ def default_lut_dir():
     return _PACKAGE_ROOT / "luts"
 
 
+def code_text(path):
+    """The code of a Python file without its comments, docstrings and blank lines: what a hash of
+    "the code that computes a table" should see (editing a comment does not make a table stale).
+    Comments are found with ``tokenize`` and docstrings with ``ast``, whose positions are the same in
+    every supported Python version (token strings are not: f-strings tokenise differently in 3.12+)."""
+    source = Path(path).read_text(encoding="utf-8")
+    lines = source.splitlines()
+    drop = set()
+    for node in ast.walk(ast.parse(source)):
+        body = getattr(node, "body", None)
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and body:
+            first = body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) \
+                    and isinstance(first.value.value, str):
+                drop.update(range(first.lineno - 1, first.end_lineno))
+    cut = {}
+    for tok in tokenize.generate_tokens(io.StringIO(source).readline):
+        if tok.type == tokenize.COMMENT:
+            cut[tok.start[0] - 1] = tok.start[1]
+    kept = []
+    for i, line in enumerate(lines):
+        if i in drop:
+            continue
+        line = line[:cut[i]] if i in cut else line
+        if line.strip():
+            kept.append(line.rstrip())
+    return "\n".join(kept)
+
+
 def inputs_hash(group_name):
-    """Hash of everything that determines a bake group's values: parameters and source code."""
+    """Hash of everything that determines a bake group's values: parameters and the code (without
+    comments and docstrings: ``code_text``) of the modules that compute it."""
     group = GROUPS[group_name]
     h = hashlib.sha256()
     h.update(json.dumps({"layout": LAYOUT_VERSION, "group": group.name,
@@ -150,7 +184,7 @@ def inputs_hash(group_name):
                         sort_keys=True).encode())
     for rel in group.sources:
         h.update(rel.encode())
-        h.update((_PACKAGE_ROOT / rel).read_bytes())
+        h.update(code_text(_PACKAGE_ROOT / rel).encode())
     return h.hexdigest()
 
 

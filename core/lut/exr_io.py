@@ -3,7 +3,7 @@
 Orientation: tables are handled in numpy as ``table[j, i, c]`` with row j = node j of the v
 axis counted from v = 0.  Blender samples image row j *from the bottom* at v = (j + 0.5)/H,
 while an EXR file stores its top row first, so rows are flipped on write and on read
-(../shared/reference/blender_addon.md §3.2).  Header attributes are prefixed ``rtl.``;
+(docs/blender.md, "Tables as images").  Header attributes are prefixed ``rtl.``;
 ``rtl.content_hash`` is the SHA-256 of the float32 table (table orientation, RGBA
 interleaved, little-endian), checked on every read.
 

@@ -1,8 +1,15 @@
-"""The RT Lit material's interface: its inputs (Principled-like) and its build-time switches.
+"""The RT Lit material's interface: its inputs and outputs, their names, and its build-time switches.
 
-Inputs are node-group sockets an artist sets or links; switches (``Features``) choose which
-techniques the group is built with, so a disabled technique carries no nodes at all (the
-switch is folded away at build time, not multiplied by zero at render time).
+Inputs are node-group sockets an artist sets or links (``RT_LIT_INPUTS``, Principled-like), the
+shading point's geometry (``GEOMETRY_INPUTS``), and the scene's lights and world: light ``i``'s
+parameter ``p`` is the input ``light_input(i, p)`` ("Light 0 Power"), the world's parameter ``p`` the
+input ``world_input(p)`` ("World SH 0").  Outputs: the total ``Radiance`` and its parts, the material's
+emission, each light's radiance and the world's (``light_output(i)``, ...), which the node backend
+turns into one Emission closure each.
+
+Switches (``Features``) choose which techniques the material is built with, so a disabled technique
+carries no nodes at all (the switch is folded away at build time, not multiplied by zero at render
+time).  Names shared by every layer (group-name prefixes) are defined here once.
 """
 from __future__ import annotations
 
@@ -39,6 +46,62 @@ RT_LIT_INPUTS = {
     "Normal": vector("Shading normal (world space); unlinked = the geometry's normal", "NONE",
                      hide_value=True),
 }
+
+#: The shading point, as the node backend's Geometry node delivers it.
+GEOMETRY_INPUTS = {
+    "Position": vector("Shading point, world space", "NONE", hide_value=True),
+    "Geometry Normal": vector("Interpolated surface normal, world space", "NONE", hide_value=True),
+    "Incoming": vector("Unit direction towards the viewer (Geometry > Incoming)", "NONE", hide_value=True),
+}
+
+#: The RT Lit surface terms every light and the world use (outputs of "RTL Surface").
+SURFACE_OUTPUTS = {
+    "N": vector("Unit shading normal", "NONE"),
+    "V": vector("Unit direction towards the viewer", "NONE"),
+    "Roughness": factor(0.5, "Blender roughness r"),
+    "F0": color((0.04, 0.04, 0.04), "Specular reflectance at normal incidence"),
+    "Dielectric F0": color((0.04, 0.04, 0.04), "F0 of the dielectric part (IOR, level, tint)"),
+    "Metal F0": color((0.8, 0.8, 0.8), "F0 of the metallic part (base colour)"),
+    "Metallic": factor(0.0, "Blend from dielectric to metal"),
+    "Albedo": color((0.8, 0.8, 0.8), "Diffuse albedo"),
+    "Wrap": factor(0.0, "Wrapped-diffuse amount"),
+    "Sheen Color": color((0.0, 0.0, 0.0), "Sheen weight times tint"),
+    "Cloth Weight": factor(0.0, "Blend from specular to cloth"),
+    "Cloth Color": color((1.0, 1.0, 1.0), "Cloth colour"),
+    "Emission": color((0.0, 0.0, 0.0), "Emitted radiance"),
+}
+
+#: Every node group built from a core function is named "RTL ..." (Add > Group lists them together).
+NODE_GROUP_PREFIX = "RTL "
+#: RT Lit material groups are named "RT Lit (<features>)" (``rt_lit_group_name``).
+RT_LIT_GROUP_PREFIX = "RT Lit"
+#: The total radiance and the parts it sums.
+RADIANCE_OUTPUT = "Radiance"
+EMISSION_OUTPUT = "Material Emission"
+WORLD_OUTPUT = "World Radiance"
+#: The light kinds RT Lit shades (area quad and disk, point, spot, sun: core/lights.py).
+LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun")
+
+
+def light_input(index, parameter):
+    """Name of light ``index``'s parameter input: "Light 0 Power"."""
+    return f"Light {index} {parameter}"
+
+
+def light_output(index):
+    """Name of light ``index``'s radiance output: "Light 0 Radiance"."""
+    return f"Light {index} Radiance"
+
+
+def world_input(parameter):
+    """Name of the world's parameter input: "World SH 0", "World Strength", "World Rotation"."""
+    return f"World {parameter}"
+
+
+def rt_lit_group_name(features):
+    """"RT Lit (<features label>)"."""
+    return f"{RT_LIT_GROUP_PREFIX} ({features.label()})"
+
 
 #: Output name -> socket.  "Shader" is the material's surface: one Emission closure per light (and
 #: one for the material's own emission), summed by Add Shader nodes.  Cycles compiles each closure's

@@ -323,7 +323,7 @@ def test_back_conversion_without_kept_principled_creates_one(bpy_module, convert
 
 @pytest.fixture
 def operators(bpy_module, convert, factory, monkeypatch):
-    monkeypatch.setattr(convert, "default_group_factory", lambda: factory)
+    monkeypatch.setattr(convert, "default_group_factory", lambda lut_dir=None: factory)
     for cls in convert.classes:
         bpy_module.utils.register_class(cls)
     yield bpy_module.ops.rtl

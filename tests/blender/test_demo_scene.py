@@ -5,14 +5,11 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 pytest.importorskip("OpenEXR")
-
-_SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
 
 pytestmark = pytest.mark.blender
 
@@ -29,13 +26,11 @@ def _principled_values(bsdf):
 def test_demo_scene_round_trips_and_reloads(empty_scene, lut_dir, tmp_path):
     import bpy
 
-    import build_demo_scene
-    from engine_parity import render_cycles_passes
     from rt_lookdev.addon import convert
-    from rt_lookdev.core.lut import lookup
+    from rt_lookdev.addon import demo_scene as build_demo_scene
+    from rt_lookdev.validation.engines import render_cycles_passes
 
-    with lookup.use_lut_dir(lut_dir):
-        spheres = build_demo_scene.build_demo_scene(lut_dir, resolution=80)
+    spheres = build_demo_scene.build_demo_scene(lut_dir, resolution=80)
     scene = bpy.context.scene
     res = (scene.render.resolution_x, scene.render.resolution_y)
     assert len(spheres) == 15 and all(convert.is_rt_lit_material(bpy.data.materials[n]) for n in spheres)
@@ -46,13 +41,12 @@ def test_demo_scene_round_trips_and_reloads(empty_scene, lut_dir, tmp_path):
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
     out = tmp_path / "reloaded.npy"
     code = f"""
-import sys, json
-sys.path.insert(0, {str(_SCRIPTS)!r})
+import json
 import bpy
 bpy.context.preferences.filepaths.use_scripts_auto_execute = False
 bpy.ops.wm.open_mainfile(filepath={str(blend)!r}, load_ui=False, use_scripts=False)
 import numpy as np
-from engine_parity import render_cycles_passes
+from rt_lookdev.validation.engines import render_cycles_passes
 np.save({str(out)!r}, render_cycles_passes(bpy.context.scene, {res!r})["Combined"])
 print("RTL_RESULT " + json.dumps({{"autoexec_fail": bpy.app.autoexec_fail}}))
 """

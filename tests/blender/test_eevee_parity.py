@@ -12,19 +12,13 @@ With the default 2x anisotropic filtering (no ``eevee_texture_filtering()``) the
 """
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 pytest.importorskip("OpenEXR")
 
-_HERE = Path(__file__).resolve().parent
-if str(_HERE) not in sys.path:
-    sys.path.insert(0, str(_HERE))
-
-from engine_parity import compare, eevee_available, render_engines  # noqa: E402
+from rt_lookdev.validation.engines import compare, eevee_available, render_engines  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -174,31 +168,29 @@ def test_eevee_matches_cycles_on_emission_tree(empty_scene):
 
 
 @pytest.mark.parametrize("kind,lobe", [("quad", "ggx"), ("quad", "lambert"), ("disk", "cod"), ("point", "ggx")])
-def test_rt_lit_lobes_compute_the_same_in_eevee(empty_scene, lut_dir, kind, lobe):
+def test_rt_lit_lobes_compute_the_same_in_eevee(empty_scene, tables, kind, lobe):
     """Identical inputs (full-float images, Closest) through the same lobe group in both engines:
     EEVEE's film truncates to half floats (relative step 2^-10 = 9.8e-4), nothing else may differ."""
     ok, why = eevee_available()
     if not ok:
         pytest.skip(why)
-    sys.path.insert(0, str(_HERE))
-    from conformance import render_group_outputs
-    from test_node_functions import _area_inputs, _punctual_inputs
+    from rt_lookdev.validation.conformance import render_group_outputs
+    from rt_lookdev.validation.grids import area_lobe_inputs as _area_inputs
+    from rt_lookdev.validation.grids import punctual_lobe_inputs as _punctual_inputs
 
     from rt_lookdev.addon.node_emit import ensure_function_group
-    from rt_lookdev.core.lut import lookup
     from rt_lookdev.core.materials import lobes
 
-    with lookup.use_lut_dir(lut_dir):
-        fn = lobes.lobe_functions(kind)[lobe]
-        vals = _punctual_inputs() if kind == "point" else _area_inputs(kind)
-        vals = {k: vals[k] for k in fn.input_sockets}
-        ng = ensure_function_group(fn, lut_dir)
-        for out in fn.output_sockets:
-            cycles = render_group_outputs(ng, vals, out)
-            eevee = render_group_outputs(ng, vals, out, engine="BLENDER_EEVEE")
-            # half floats: values above 65504 (a point light on a mirror, r = 0) saturate in EEVEE
-            big = (cycles > 1e-3) & (cycles < 65504.0)
-            rel = np.abs(eevee[big] - cycles[big]) / cycles[big]
-            print(f"{fn.name}.{out}: {big.sum()} values, EEVEE vs Cycles median {np.median(rel):.2e}, "
-                  f"max {rel.max():.2e}")
-            assert big.sum() > 20 and rel.max() <= 1.5e-3
+    fn = lobes.LOBES[lobe].function(kind)
+    vals = _punctual_inputs() if kind == "point" else _area_inputs(kind)
+    vals = {k: vals[k] for k in fn.input_sockets}
+    ng = ensure_function_group(fn, tables)
+    for out in fn.output_sockets:
+        cycles = render_group_outputs(ng, vals, out)
+        eevee = render_group_outputs(ng, vals, out, engine="BLENDER_EEVEE")
+        # half floats: values above 65504 (a point light on a mirror, r = 0) saturate in EEVEE
+        big = (cycles > 1e-3) & (cycles < 65504.0)
+        rel = np.abs(eevee[big] - cycles[big]) / cycles[big]
+        print(f"{fn.name}.{out}: {big.sum()} values, EEVEE vs Cycles median {np.median(rel):.2e}, "
+              f"max {rel.max():.2e}")
+        assert big.sum() > 20 and rel.max() <= 1.5e-3

@@ -14,7 +14,7 @@ import pytest
 
 pytest.importorskip("OpenEXR")
 
-import validate_energy as ve  # noqa: E402  (scripts/ is on sys.path via tests/conftest.py)
+from rt_lookdev.validation import energy_render as ve  # noqa: E402
 
 pytestmark = pytest.mark.blender
 

@@ -7,7 +7,7 @@ from pathlib import PurePosixPath
 
 import pytest
 
-import build_extension
+from rt_lookdev.validation import extension_zip as build_extension
 from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
@@ -108,7 +108,8 @@ def test_zip_holds_runtime_files_only(extension_zip):
     assert any(n.startswith("node_groups/") for n in names)
     assert any(PurePosixPath(n).match("luts/*.exr") for n in names)
     top = {PurePosixPath(n).parts[0] for n in names}
-    assert not top & {"tests", "scripts", "docs", ".ci", ".git", ".venv", "dist", "out"}
+    assert not top & {"tests", "scripts", "validation", "docs", ".ci", ".git", ".venv", "dist", "out",
+                      "pyproject.toml"}
     assert not [n for n in names if "__pycache__" in n or n.endswith(".pyc")]
 
 
@@ -116,7 +117,7 @@ def test_zip_check_rejects_development_files():
     good = ["__init__.py", "blender_manifest.toml", "addon/__init__.py", "core/__init__.py",
             "core/lut/catalog.py", "node_groups/__init__.py", "luts/e.exr"]
     build_extension.check_zip_contents(good, ["luts/e.exr"])
-    for extra in ("tests/conftest.py", "scripts/env.sh", ".ci/run", "core/__pycache__/x.pyc"):
+    for extra in ("tests/conftest.py", "scripts/env.sh", "validation/suite.py", ".ci/run", "core/__pycache__/x.pyc"):
         with pytest.raises(build_extension.BuildError, match="should not be shipped"):
             build_extension.check_zip_contents(good + [extra])
     with pytest.raises(build_extension.BuildError, match="missing LUT: luts/f.exr"):
@@ -139,7 +140,7 @@ def test_install_enable_run_disable_leaves_nothing_behind(extension_zip, tmp_pat
     assert "blender_manifest.toml" in files and "addon/operators.py" in files
     exrs = [f for f in files if PurePosixPath(f).match("luts/*.exr")]
     assert exrs, f"no luts/*.exr installed: {files}"
-    assert not [f for f in files if f.startswith(("tests/", "scripts/", ".ci/"))]
+    assert not [f for f in files if f.startswith(("tests/", "scripts/", "validation/", ".ci/"))]
     # The installed add-on reads its own copy of the tables, and they are all ok.
     assert result["default_lut_dir"].startswith(result["installed_dir"])
     assert result["lut_states"] and set(result["lut_states"].values()) == {"ok"}, result["lut_states"]

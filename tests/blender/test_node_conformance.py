@@ -2,27 +2,19 @@
 rendered per pixel by Cycles, equals the numpy backend (float32) on a 64x64 grid of inputs."""
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from rt_lookdev.core import diffuse
+from rt_lookdev.core.ir import trace
+from rt_lookdev.core.ir.expr import topological_order
+from rt_lookdev.core.ir.numpy_backend import evaluate, node_count
+from rt_lookdev.validation.conformance import ATOL, LAST_RENDER_SECONDS, NEAR_ZERO, RTOL, render_group_outputs
+from rt_lookdev.validation.conformance import compare as _compare
+from rt_lookdev.validation.grids import TECHNIQUES
+from rt_lookdev.validation.grids import technique_inputs as _inputs
+
 pytest.importorskip("OpenEXR")
-
-_HERE = Path(__file__).resolve().parent
-for _p in (_HERE, _HERE.parent / "core"):
-    if str(_p) not in sys.path:
-        sys.path.insert(0, str(_p))
-
-from conformance import LAST_RENDER_SECONDS, render_group_outputs  # noqa: E402
-from function_conformance import ATOL, NEAR_ZERO, RTOL  # noqa: E402
-from function_conformance import compare as _compare  # noqa: E402
-from test_ir import TECHNIQUES, _inputs  # noqa: E402
-
-from rt_lookdev.core import diffuse  # noqa: E402
-from rt_lookdev.core.ir import trace  # noqa: E402
-from rt_lookdev.core.ir.numpy_backend import evaluate, node_count, topological_order  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -190,29 +182,26 @@ def test_power_of_zero_with_negative_exponent(empty_scene):
     assert np.all(ref == 0.0)
 
 
-def test_lut_lookup_matches(empty_scene, lut_dir):
+def test_lut_lookup_matches(empty_scene, tables):
     """Table lookups in nodes, every channel, coordinates inside and outside the texel-centre range:
     the raw Image Texture ops ("lut": Linear; "texel": Closest) and the bilinear node function that
-    shading code uses (four Closest fetches), all against core.lut.lookup.sample_bilinear."""
+    shading code uses (four Closest fetches), all against core.ir.semantics.sample_bilinear."""
     from rt_lookdev.addon.node_emit import build_node_group, node_group_stats, tree_node_counts
     from rt_lookdev.core import shading_ops as op
     from rt_lookdev.core.ir import trace
-    from rt_lookdev.core.lut import catalog, exr_io
-    from rt_lookdev.core.lut.lookup import sample_bilinear
+    from rt_lookdev.core.ir.semantics import sample_bilinear
 
-    table = exr_io.read_table(lut_dir / catalog.TABLES["ltc_ggx_inv"].filename)[0]
-    lut = op.Lut("ltc_ggx_inv", table)
+    lut = tables["ltc_ggx_inv"]
+    table = lut.require_data()
 
     def lookups(u, v):
         g = u.graph
-        g.luts.setdefault(lut.name, table)
-        raw = tuple(g.make(kind, (u, v), (("table", lut.name), ("channel", c)))
-                    for kind in ("lut", "texel") for c in range(4))
+        raw = tuple(g.read_table(lut, u, v, c, op=kind) for kind in ("lut", "texel") for c in range(4))
         return raw + tuple(op.lut_sample(lut, u, v, c) for c in range(4))
 
     _, outs = trace(lookups, {"u": "float", "v": "float"})
     names = [f"{kind}{c}" for kind in ("linear", "closest", "bilinear") for c in range(4)]
-    ng = build_node_group("RTL_lut", dict(zip(names, outs)), input_order=["u", "v"], lut_dir=lut_dir)
+    ng = build_node_group("RTL_lut", dict(zip(names, outs)), input_order=["u", "v"], tables=tables)
     assert node_group_stats(ng)["ShaderNodeTexImage"] == 2       # one Linear, one Closest texture
     inner = [n.node_tree for n in ng.nodes if n.bl_idname == "ShaderNodeGroup"]
     assert len(inner) == 1 and inner[0].name == "RTL LUT ltc_ggx_inv"
@@ -226,22 +215,21 @@ def test_lut_lookup_matches(empty_scene, lut_dir):
     exact = sample_bilinear(table, vals["u"], vals["v"])
     for name, o in zip(names, outs):
         got = render_group_outputs(ng, vals, name)
-        _check(f"lut {name}", got, evaluate(o, vals))
+        _check(f"lut {name}", got, evaluate(o, vals, tables=tables))
         if name.startswith("bilinear"):
             np.testing.assert_allclose(got, exact[..., int(name[-1])], rtol=2e-6, atol=2e-6)
 
 
-def test_lut_driven_kulla_conty_lobe_matches(empty_scene, lut_dir):
+def test_lut_driven_kulla_conty_lobe_matches(empty_scene, tables):
     """A technique that reads tables: the Kulla-Conty lobe from the energy LUTs, in nodes."""
-    from rt_lookdev.addon.node_emit import build_node_group, node_group_stats
+    from rt_lookdev.addon.node_emit import build_node_group
     from rt_lookdev.core import multiscatter
     from rt_lookdev.core import shading_ops as op
     from rt_lookdev.core.ir import trace
-    from rt_lookdev.core.lut import catalog, exr_io
+    from rt_lookdev.core.lut import catalog
     from rt_lookdev.core.lut.lookup import lut_coordinate
 
-    luts = {name: op.Lut(name, exr_io.read_table(lut_dir / catalog.TABLES[name].filename)[0])
-            for name in ("ggx_one_minus_E", "ggx_one_minus_E_avg")}
+    luts = tables
 
     def lobe(mu_o, mu_i, r, f0):
         u = lut_coordinate(r, catalog.ENERGY_SIZE)
@@ -252,7 +240,7 @@ def test_lut_driven_kulla_conty_lobe_matches(empty_scene, lut_dir):
 
     names = ["mu_o", "mu_i", "r", "f0"]
     _, out = trace(lobe, dict.fromkeys(names, "float"))
-    ng = build_node_group("RTL_kc_lut", {"out": out}, input_order=names, lut_dir=lut_dir)
+    ng = build_node_group("RTL_kc_lut", {"out": out}, input_order=names, tables=tables)
     lut_calls = [n.node_tree.name for n in ng.nodes if n.bl_idname == "ShaderNodeGroup"]
     assert sorted(lut_calls) == ["RTL LUT ggx_one_minus_E"] * 2 + ["RTL LUT ggx_one_minus_E_avg"]
     rng = np.random.default_rng(11)
@@ -260,8 +248,8 @@ def test_lut_driven_kulla_conty_lobe_matches(empty_scene, lut_dir):
     vals["r"][0, :6] = [0.0, 1.0, 1 / 63, 0.5, 1e-4, 1 - 1e-4]
     got = render_group_outputs(ng, vals, "out")
     direct = lobe(**{k: v.astype(np.float64) for k, v in vals.items()})   # numpy, no IR
-    assert np.allclose(evaluate(out, vals, dtype=np.float64), direct, rtol=1e-6, atol=1e-12)
-    _check("kulla_conty_lut", got, evaluate(out, vals))
+    assert np.allclose(evaluate(out, vals, dtype=np.float64, tables=tables), direct, rtol=1e-6, atol=1e-12)
+    _check("kulla_conty_lut", got, evaluate(out, vals, tables=tables))
     # with 1 - E_avg stored, float32 (Cycles) also agrees with float64 numpy
     assert np.allclose(got, direct, rtol=1e-4, atol=1e-7)
 

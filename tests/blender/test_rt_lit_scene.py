@@ -6,19 +6,14 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from rt_lookdev.validation import lit_scene as rt_lit_scene
+from rt_lookdev.validation.engines import render_cycles_passes
+
 pytest.importorskip("OpenEXR")
-
-_HERE = Path(__file__).resolve().parent
-if str(_HERE) not in sys.path:
-    sys.path.insert(0, str(_HERE))
-
-import rt_lit_scene  # noqa: E402
-from engine_parity import render_cycles_passes  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -32,9 +27,9 @@ def _features():
             ("typical", Features("turquin", "cod"))]
 
 
-def _render_and_compare(scene):
+def _render_and_compare(scene, tables):
     p = render_cycles_passes(scene, (scene.render.resolution_x, scene.render.resolution_y))
-    ref, hit = rt_lit_scene.numpy_radiance(scene, p)
+    ref, hit = rt_lit_scene.numpy_radiance(scene, p, tables)
     got = p["Combined"]
     assert np.all(np.isfinite(got)) and np.all(np.isfinite(ref))
     err = np.abs(got - ref)
@@ -61,52 +56,45 @@ def _set_material_values(scene):
 HDRI = "forest"        # the demo scene's: its bake is cached once per test session
 
 
-def test_rt_lit_renders_like_numpy_and_follows_light_edits(empty_scene, lut_dir):
-    from rt_lookdev.core.lut import lookup
-
-    with lookup.use_lut_dir(lut_dir):
-        scene = rt_lit_scene.build(_features(), hdri=HDRI)
-        _set_material_values(scene)
-        before, hit = _render_and_compare(scene)
-        # move and resize lights: drivers carry the change, no sync needed
-        quad, ellipse, spot = (scene.objects[n] for n in ("Quad", "Ellipse", "Spot"))
-        quad.location = (2.4, -1.0, 2.2)
-        rt_lit_scene.aim(quad)
-        quad.scale = (1.5, 0.5, 1.0)
-        ellipse.data.size = 2.0
-        spot.data.energy = 800.0
-        spot.data.spot_size = 1.3
-        scene.objects["Sun"].data.color = (1.0, 0.5, 0.25)
-        nodes = scene.world.node_tree.nodes
-        nodes["Background"].inputs["Strength"].default_value = 1.3
-        nodes["Mapping"].inputs["Rotation"].default_value = (0.4, -0.3, 2.5)
-        after, _ = _render_and_compare(scene)
-        changed = np.abs(after - before).max(axis=-1) > 1e-3
-        assert changed[hit].mean() > 0.3
+def test_rt_lit_renders_like_numpy_and_follows_light_edits(empty_scene, lut_dir, tables):
+    scene = rt_lit_scene.build(_features(), hdri=HDRI, lut_dir=lut_dir)
+    _set_material_values(scene)
+    before, hit = _render_and_compare(scene, tables)
+    # move and resize lights: drivers carry the change, no sync needed
+    quad, ellipse, spot = (scene.objects[n] for n in ("Quad", "Ellipse", "Spot"))
+    quad.location = (2.4, -1.0, 2.2)
+    rt_lit_scene.aim(quad)
+    quad.scale = (1.5, 0.5, 1.0)
+    ellipse.data.size = 2.0
+    spot.data.energy = 800.0
+    spot.data.spot_size = 1.3
+    scene.objects["Sun"].data.color = (1.0, 0.5, 0.25)
+    nodes = scene.world.node_tree.nodes
+    nodes["Background"].inputs["Strength"].default_value = 1.3
+    nodes["Mapping"].inputs["Rotation"].default_value = (0.4, -0.3, 2.5)
+    after, _ = _render_and_compare(scene, tables)
+    changed = np.abs(after - before).max(axis=-1) > 1e-3
+    assert changed[hit].mean() > 0.3
 
 
 def test_scene_reloads_without_python_and_renders_identically(empty_scene, lut_dir, tmp_path):
     import bpy
 
-    from rt_lookdev.core.lut import lookup
-
-    with lookup.use_lut_dir(lut_dir):
-        scene = rt_lit_scene.build(_features(), hdri=HDRI)
-        _set_material_values(scene)
-        scene.world.node_tree.nodes["Mapping"].inputs["Rotation"].default_value = (0.0, 0.2, -1.0)
-        res = (scene.render.resolution_x, scene.render.resolution_y)
-        here = render_cycles_passes(scene, res)["Combined"]
+    scene = rt_lit_scene.build(_features(), hdri=HDRI, lut_dir=lut_dir)
+    _set_material_values(scene)
+    scene.world.node_tree.nodes["Mapping"].inputs["Rotation"].default_value = (0.0, 0.2, -1.0)
+    res = (scene.render.resolution_x, scene.render.resolution_y)
+    here = render_cycles_passes(scene, res)["Combined"]
     blend = tmp_path / "rt_lit.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
     out = tmp_path / "reloaded.npy"
     code = f"""
-import sys, json
-sys.path[:0] = [{str(_HERE)!r}, {str(_HERE.parents[1] / 'scripts')!r}]
+import json
 import bpy
 bpy.context.preferences.filepaths.use_scripts_auto_execute = False
 bpy.ops.wm.open_mainfile(filepath={str(blend)!r}, load_ui=False, use_scripts=False)
 import numpy as np
-from engine_parity import render_cycles_passes
+from rt_lookdev.validation.engines import render_cycles_passes
 scene = bpy.context.scene
 drivers = [fc.driver for ng in bpy.data.node_groups if ng.animation_data for fc in ng.animation_data.drivers]
 img = render_cycles_passes(scene, {res!r})["Combined"]
@@ -127,35 +115,32 @@ print("RTL_RESULT " + json.dumps({{"autoexec_fail": bpy.app.autoexec_fail, "driv
 def test_groups_carry_only_what_the_scene_and_material_need(empty_scene, lut_dir):
     import bpy
 
-    from rt_lookdev.addon import materials
     from rt_lookdev.addon.node_emit import MAX_GROUP_NODES, tree_node_counts
-    from rt_lookdev.core.lut import lookup
-    from rt_lookdev.core.materials.rt_lit_interface import Features
+    from rt_lookdev.core.materials.rt_lit_interface import Features, rt_lit_group_name
 
-    with lookup.use_lut_dir(lut_dir):
-        scene = rt_lit_scene.build([("plain", Features("single", "lambert"))], kinds=("quad", "sun"))
-        ng = bpy.data.node_groups[materials.rt_lit_group_name(Features("single", "lambert"))]
-        names = set(tree_node_counts(ng))
-        assert any("Quad" in n for n in names) and any("Sun" in n for n in names)
-        assert not any("Disk" in n or "Spot" in n or "Point" in n for n in names)     # no such lights
-        assert not any(w in n for n in names for w in ("Sheen", "Cloth", "Kulla", "CoD", "Wrapped", "World",
-                                                       "Environment"))         # no world image either
-        assert not any(i.name.startswith("RTL_env_") for i in bpy.data.images)
-        assert max(tree_node_counts(ng).values()) <= MAX_GROUP_NODES
-        # a light added later joins after a sync; the group is rebuilt in place
-        data = bpy.data.lights.new("Late", "POINT")
-        data.shadow_soft_size = 0.0
-        late = bpy.data.objects.new("Late", data)
-        late.location = (0.0, -3.0, 0.0)
-        scene.collection.objects.link(late)
-        before = render_cycles_passes(scene, (48, 48))["Combined"]
-        from rt_lookdev.addon.operators import RTL_OT_sync_lights
+    scene = rt_lit_scene.build([("plain", Features("single", "lambert"))], kinds=("quad", "sun"), lut_dir=lut_dir)
+    ng = bpy.data.node_groups[rt_lit_group_name(Features("single", "lambert"))]
+    names = set(tree_node_counts(ng))
+    assert any("Quad" in n for n in names) and any("Sun" in n for n in names)
+    assert not any("Disk" in n or "Spot" in n or "Point" in n for n in names)     # no such lights
+    assert not any(w in n for n in names for w in ("Sheen", "Cloth", "Kulla", "CoD", "Wrapped", "World",
+                                                   "Environment"))         # no world image either
+    assert not any(i.name.startswith("RTL_env_") for i in bpy.data.images)
+    assert max(tree_node_counts(ng).values()) <= MAX_GROUP_NODES
+    # a light added later joins after a sync; the group is rebuilt in place
+    data = bpy.data.lights.new("Late", "POINT")
+    data.shadow_soft_size = 0.0
+    late = bpy.data.objects.new("Late", data)
+    late.location = (0.0, -3.0, 0.0)
+    scene.collection.objects.link(late)
+    before = render_cycles_passes(scene, (48, 48))["Combined"]
+    from rt_lookdev.addon.operators import RTL_OT_sync_lights
 
-        bpy.utils.register_class(RTL_OT_sync_lights)
-        try:
-            assert bpy.ops.rtl.sync_lights() == {"FINISHED"}
-        finally:
-            bpy.utils.unregister_class(RTL_OT_sync_lights)
-        assert any("Point" in n for n in tree_node_counts(ng))
-        after = render_cycles_passes(scene, (48, 48))["Combined"]
-        assert after.sum() > before.sum()
+    bpy.utils.register_class(RTL_OT_sync_lights)
+    try:
+        assert bpy.ops.rtl.sync_lights() == {"FINISHED"}
+    finally:
+        bpy.utils.unregister_class(RTL_OT_sync_lights)
+    assert any("Point" in n for n in tree_node_counts(ng))
+    after = render_cycles_passes(scene, (48, 48))["Combined"]
+    assert after.sum() > before.sum()

@@ -13,17 +13,11 @@ Runs in about 25 s on 2 cores.
 """
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 pytest.importorskip("OpenEXR")
-
-_SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
-if str(_SCRIPTS) not in sys.path:
-    sys.path.insert(0, str(_SCRIPTS))
 
 pytestmark = pytest.mark.blender
 
@@ -41,7 +35,7 @@ PUNCTUAL_TOL = (0.002, 0.01)         # deterministic lights: the BRDFs themselve
 
 @pytest.fixture(scope="module")
 def validation(tmp_path_factory, lut_dir, bpy_module):
-    import validate
+    from rt_lookdev.validation import suite as validate
 
     out = tmp_path_factory.mktemp("validation")
     args = validate.parse_args(["--quick", "--out", str(out), "--samples", "64", "--brute-pixels", "80",

@@ -19,16 +19,10 @@ cache of tests/conftest.py holds it).
 from __future__ import annotations
 
 import os
-import sys
-from pathlib import Path
 
 import pytest
 
 pytest.importorskip("OpenEXR")
-
-_SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
-if str(_SCRIPTS) not in sys.path:
-    sys.path.insert(0, str(_SCRIPTS))
 
 pytestmark = pytest.mark.blender
 
@@ -38,7 +32,7 @@ HARNESS_MEDIAN = 0.025         # texel-sum Lambert vs Cycles at 256 spp x 2: noi
 
 @pytest.fixture(scope="module")
 def world_validation(tmp_path_factory, lut_dir, bpy_module):
-    import validate_world
+    from rt_lookdev.validation import world_suite as validate_world
 
     out = tmp_path_factory.mktemp("validation_world")
     argv = ["--quick", "--no-bake-timing", "--out", str(out), "--lut-dir", str(lut_dir),

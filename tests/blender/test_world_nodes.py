@@ -1,26 +1,20 @@
-"""The World term's node functions (core/materials/world.py) rendered by Cycles equal numpy.
+"""The World term's node functions (core/materials/world_shading.py) rendered by Cycles equal numpy.
 
 Every function of the world term, fed 48 x 48 grids of inputs (directions over the whole sphere
 with the poles and the equirect seam, roughness 0 and 1 and between levels, V below the horizon,
 rotations), is emitted as its node group and rendered; each output is compared with the traced
-graph evaluated in float32 (function_conformance: 1e-4 relative, 1e-6 absolute near zero).  The
+graph evaluated in float32 (validation.conformance.check_function: 1e-4 relative, 1e-6 absolute near zero).  The
 prefiltered environment is a random 9-level table written as an EXR like the bake's.
 """
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from rt_lookdev.validation.conformance import check_function
+from rt_lookdev.validation.grids import unit_vectors
+
 pytest.importorskip("OpenEXR")
-
-_HERE = Path(__file__).resolve().parent
-if str(_HERE) not in sys.path:
-    sys.path.insert(0, str(_HERE))
-
-from function_conformance import check_function, unit_vectors  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -31,7 +25,7 @@ LEVELS = tuple(k / 8.0 for k in range(9))
 @pytest.fixture(scope="module")
 def environment(tmp_path_factory):
     from rt_lookdev.core.lut import exr_io
-    from rt_lookdev.core.materials import world
+    from rt_lookdev.core.materials import world_shading as world
 
     rng = np.random.default_rng(11)
     h, w = 16, 32
@@ -74,64 +68,59 @@ def _inputs(seed=5):
     return vals
 
 
-def _check(fn, lut_dir):
+def _check(fn, tables):
     vals = _inputs()
-    return check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, lut_dir)
+    return check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, tables)
 
 
-def test_prefiltered_lookup_group_matches_numpy(empty_scene, lut_dir, environment):
+def test_prefiltered_lookup_group_matches_numpy(empty_scene, tables, environment):
+    from rt_lookdev.core.materials import world_shading as world
+
+    env, _ = environment
+    tables = tables.with_tables(env.as_table())
+    _check(world.prefiltered_function(env), tables)
+
+
+def test_world_helper_groups_match_numpy(empty_scene, tables):
+    from rt_lookdev.core.materials import world_shading as world
+
+    for fn in (world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD, world.SH_LTC_CLOTH, world.SH_LTC_SHEEN):
+        _check(fn, tables)
+    for model in ("single", "turquin", "fdez_aguera", "kulla_conty"):
+        for form in (("irradiance", "radiance") if model == "fdez_aguera" else ("irradiance",)):
+            _check(world.specular_function(model, form), tables)
+
+
+def test_shade_world_groups_match_numpy(empty_scene, tables, environment):
     from rt_lookdev.addon import node_emit
-    from rt_lookdev.core.materials import world
-
-    env, path = environment
-    node_emit.register_image(env.name, path)
-    _check(world.prefiltered_function(env), lut_dir)
-
-
-def test_world_helper_groups_match_numpy(empty_scene, lut_dir):
-    from rt_lookdev.core.lut import lookup
-    from rt_lookdev.core.materials import world
-
-    with lookup.use_lut_dir(lut_dir):
-        for fn in (world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD, world.SH_LTC_CLOTH, world.SH_LTC_SHEEN):
-            _check(fn, lut_dir)
-        for model in ("single", "turquin", "fdez_aguera", "kulla_conty"):
-            for form in (("irradiance", "radiance") if model == "fdez_aguera" else ("irradiance",)):
-                _check(world.specular_function(model, form), lut_dir)
-
-
-def test_shade_world_groups_match_numpy(empty_scene, lut_dir, environment):
-    from rt_lookdev.addon import node_emit
-    from rt_lookdev.core.lut import lookup
-    from rt_lookdev.core.materials import world
+    from rt_lookdev.core.materials import world_shading as world
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
-    env, path = environment
-    node_emit.register_image(env.name, path)
-    with lookup.use_lut_dir(lut_dir):
-        for features in (Features("fdez_aguera", "cod", sheen=True, cloth=True),
-                         Features("kulla_conty", "wrapped"), Features("single", "lambert")):
-            fn = world.shade_world_function(features, env)
-            _check(fn, lut_dir)
-            counts = node_emit.tree_node_counts(node_emit.ensure_function_group(fn, lut_dir))
-            assert max(counts.values()) <= node_emit.MAX_GROUP_NODES, counts
+    env, _ = environment
+    tables = tables.with_tables(env.as_table())
+    for features in (Features("fdez_aguera", "cod", sheen=True, cloth=True),
+                     Features("kulla_conty", "wrapped"), Features("single", "lambert")):
+        fn = world.shade_world_function(features, env)
+        _check(fn, tables)
+        counts = node_emit.tree_node_counts(node_emit.ensure_function_group(fn, tables))
+        assert max(counts.values()) <= node_emit.MAX_GROUP_NODES, counts
 
 
-def test_shade_world_computes_the_same_in_eevee(empty_scene, lut_dir, tmp_path):
+def test_shade_world_computes_the_same_in_eevee(empty_scene, tables, tmp_path):
     """Identical inputs through the whole world group in both engines, on a smooth environment (a
     random table would turn Mesa's approximate arccosine, 3.1e-4 relative (docs/conventions.md), into
     texel-to-texel jumps): EEVEE's half-float film is the only difference allowed."""
-    from engine_parity import eevee_available
+    from rt_lookdev.validation.engines import eevee_available
 
     ok, why = eevee_available()
     if not ok:
         pytest.skip(why)
-    from conformance import render_group_outputs
+    from rt_lookdev.validation.conformance import render_group_outputs
 
     from rt_lookdev.addon import node_emit
     from rt_lookdev.core.environment import equirect
-    from rt_lookdev.core.lut import exr_io, lookup
-    from rt_lookdev.core.materials import world
+    from rt_lookdev.core.lut import exr_io
+    from rt_lookdev.core.materials import world_shading as world
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
     h, w = 16, 32
@@ -143,14 +132,13 @@ def test_shade_world_computes_the_same_in_eevee(empty_scene, lut_dir, tmp_path):
     path = tmp_path / "env_smooth.exr"
     exr_io.write_table(path, table, {"table": "env_smooth", "roughness_levels": str(list(LEVELS))})
     env = world.WorldEnvironment.load(path, "env_smooth_eevee")
-    node_emit.register_image(env.name, path)
-    with lookup.use_lut_dir(lut_dir):
-        fn = world.shade_world_function(Features("fdez_aguera", "cod", sheen=True, cloth=True), env)
-        vals = _inputs()
-        vals = {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}
-        ng = node_emit.ensure_function_group(fn, lut_dir)
-        cycles = render_group_outputs(ng, vals, "Radiance")
-        eevee = render_group_outputs(ng, vals, "Radiance", engine="BLENDER_EEVEE")
+    tables = tables.with_tables(env.as_table())
+    fn = world.shade_world_function(Features("fdez_aguera", "cod", sheen=True, cloth=True), env)
+    vals = _inputs()
+    vals = {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}
+    ng = node_emit.ensure_function_group(fn, tables)
+    cycles = render_group_outputs(ng, vals, "Radiance")
+    eevee = render_group_outputs(ng, vals, "Radiance", engine="BLENDER_EEVEE")
     big = (cycles > 1e-3) & (cycles < 65504.0)
     rel = np.abs(eevee[big] - cycles[big]) / cycles[big]
     print(f"{fn.name}: {big.sum()} values, EEVEE vs Cycles median {np.median(rel):.2e}, "

@@ -1,4 +1,4 @@
-"""addon/world.py: which worlds RT Lit can use, their pixels, the cached bake, the "RTL World" group
+"""addon/world_sync.py: which worlds RT Lit can use, their pixels, the cached bake, the "RTL World" group
 and its drivers, and the Sync World operator (in-process bpy, small synthetic images)."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ H, W = 32, 64
 
 @pytest.fixture
 def world_mod(bpy_module, empty_scene, tmp_path, monkeypatch):
-    from rt_lookdev.addon import world
+    from rt_lookdev.addon import world_sync as world
 
     monkeypatch.setenv(world.CACHE_ENV, str(tmp_path / "env-cache"))
     yield world
@@ -272,8 +272,6 @@ def _use_group(bpy, scene, group):
 
 def test_sync_world_group_and_drivers(bpy_module, world_mod, small, tmp_path):
     bpy = bpy_module
-    from rt_lookdev.addon import node_emit
-
     scene = bpy.context.scene
     world = _world(bpy, scene, _image(bpy, "env", _environment()), mapping="POINT")
     bg = world.node_tree.nodes["Background"]
@@ -290,7 +288,8 @@ def test_sync_world_group_and_drivers(bpy_module, world_mod, small, tmp_path):
     ng = bpy.data.node_groups[world_mod.WORLD_GROUP]
     assert ng["rtl_world"].to_dict() == record
     assert record["table"] == f"env_{bake.prefiltered_hash[:12]}"
-    assert node_emit._table_path(record["table"], None) == bake.prefiltered_path
+    env, _ = world_mod.world_environment()
+    assert env.name == record["table"] and env.as_table().source == bake.prefiltered_path
 
     outputs = [(it.name, it.socket_type) for it in ng.interface.items_tree if it.item_type == "SOCKET"]
     assert outputs == ([(f"World SH {i}", "NodeSocketVector") for i in range(9)]
@@ -389,7 +388,6 @@ def test_sync_world_switches_the_rt_lit_term_and_drops_stale_images(bpy_module, 
     bpy = bpy_module
     from rt_lookdev.addon import materials, node_emit
     from rt_lookdev.core.environment import prefilter
-    from rt_lookdev.core.lut import lookup
 
     scene = bpy.context.scene
     mesh = bpy.data.meshes.new("quad")
@@ -408,25 +406,24 @@ def test_sync_world_switches_the_rt_lit_term_and_drops_stale_images(bpy_module, 
     def env_images():
         return sorted(i.name for i in bpy.data.images if i.name.startswith("RTL_env_"))
 
-    with lookup.use_lut_dir(lut_dir):
-        materials.assign_rt_lit(mat, scene=scene, lut_dir=lut_dir)
-        assert not world_groups() and not env_images()          # no world: nothing built or loaded
-        _world(bpy, scene, _image(bpy, "env", _environment()))
-        assert sync_operator() == {'FINISHED'}
-        first = dict(bpy.data.node_groups[world_mod.WORLD_GROUP]["rtl_world"])["table"]
-        assert len(world_groups()) == 1 and env_images() == [f"RTL_{first}"]
+    materials.assign_rt_lit(mat, scene=scene, lut_dir=lut_dir)
+    assert not world_groups() and not env_images()          # no world: nothing built or loaded
+    _world(bpy, scene, _image(bpy, "env", _environment()))
+    assert sync_operator() == {'FINISHED'}
+    first = dict(bpy.data.node_groups[world_mod.WORLD_GROUP]["rtl_world"])["table"]
+    assert len(world_groups()) == 1 and env_images() == [f"RTL_{first}"]
 
-        other = settings_class(32, 16, (0.0, 0.5, 1.0))
-        monkeypatch.setattr(prefilter, "PrefilterSettings", lambda: other)
-        assert sync_operator() == {'FINISHED'}
-        second = dict(bpy.data.node_groups[world_mod.WORLD_GROUP]["rtl_world"])["table"]
-        assert second != first and env_images() == [f"RTL_{second}"]
-        assert tuple(bpy.data.images[f"RTL_{second}"].size) == (32, 16 * 3)
+    other = settings_class(32, 16, (0.0, 0.5, 1.0))
+    monkeypatch.setattr(prefilter, "PrefilterSettings", lambda: other)
+    assert sync_operator() == {'FINISHED'}
+    second = dict(bpy.data.node_groups[world_mod.WORLD_GROUP]["rtl_world"])["table"]
+    assert second != first and env_images() == [f"RTL_{second}"]
+    assert tuple(bpy.data.images[f"RTL_{second}"].size) == (32, 16 * 3)
 
-        scene.world.node_tree.nodes["Environment Texture"].image = None
-        assert sync_operator() == {'FINISHED'}
-        assert world_mod.WORLD_GROUP not in bpy.data.node_groups
-        assert not world_groups() and not env_images()
+    scene.world.node_tree.nodes["Environment Texture"].image = None
+    assert sync_operator() == {'FINISHED'}
+    assert world_mod.WORLD_GROUP not in bpy.data.node_groups
+    assert not world_groups() and not env_images()
 
 
 def test_rt_lit_rebuilds_from_the_packed_image_when_the_cache_is_gone(bpy_module, world_mod, small, lut_dir,
@@ -434,27 +431,24 @@ def test_rt_lit_rebuilds_from_the_packed_image_when_the_cache_is_gone(bpy_module
     """The .blend carries the prefiltered image: with the cache file deleted (another machine), the RT
     Lit group is traced from the packed pixels, gets the same stamp (no rebuild) and the same values."""
     bpy = bpy_module
-    from rt_lookdev.addon import materials, node_emit
-    from rt_lookdev.core.lut import lookup
-    from rt_lookdev.core.materials.world import WorldEnvironment
+    from rt_lookdev.addon import materials
+    from rt_lookdev.core.materials.world_shading import WorldEnvironment
 
     scene = bpy.context.scene
     _world(bpy, scene, _image(bpy, "env", _environment()))
     record = world_mod.sync_world(scene, tmp_path / "cache", settings=small)
     mat = bpy.data.materials.new("rt")
-    with lookup.use_lut_dir(lut_dir):
-        materials.assign_rt_lit(mat, scene=scene, lut_dir=lut_dir)
-        ng = mat.node_tree.nodes["RT Lit"].node_tree
-        stamp = ng["rtl_stamp"]
-        from_file = WorldEnvironment.load(record["prefiltered"], record["table"])
-        for path in (tmp_path / "cache").iterdir():
-            path.unlink()
-        node_emit._EXTRA_IMAGES.clear()
-        env, _ = materials.world_environment()
-        np.testing.assert_array_equal(env.table, from_file.table)
-        assert env.roughness_levels == from_file.roughness_levels == tuple(small.roughness)
-        again = materials.ensure_rt_lit_group(scene=scene, lut_dir=lut_dir)
-        assert again == ng and ng["rtl_stamp"] == stamp
-        bpy.data.images.remove(bpy.data.images[f"RTL_{record['table']}"])
-        with pytest.raises(RuntimeError, match="Sync RT Lit World again"):
-            materials.world_environment()
+    materials.assign_rt_lit(mat, scene=scene, lut_dir=lut_dir)
+    ng = mat.node_tree.nodes["RT Lit"].node_tree
+    stamp = ng["rtl_stamp"]
+    from_file = WorldEnvironment.load(record["prefiltered"], record["table"])
+    for path in (tmp_path / "cache").iterdir():
+        path.unlink()
+    env, _ = world_mod.world_environment()
+    np.testing.assert_array_equal(env.table, from_file.table)
+    assert env.roughness_levels == from_file.roughness_levels == tuple(small.roughness)
+    again = materials.ensure_rt_lit_group(scene=scene, lut_dir=lut_dir)
+    assert again == ng and ng["rtl_stamp"] == stamp
+    bpy.data.images.remove(bpy.data.images[f"RTL_{record['table']}"])
+    with pytest.raises(RuntimeError, match="Sync RT Lit World again"):
+        world_mod.world_environment()

@@ -13,7 +13,8 @@ def test_velvet_distribution_is_normalised(alpha):
 
 
 def test_cloth_albedo_reference_values():
-    # multiscatter.md §3 [computed]: Ashikhmin/Neubelt, alpha = 0.5, F = 1: 0.57 / 0.25 / 0.13
+    # docs/multiscattering.md, "Cloth and sheen" (computed): Ashikhmin/Neubelt, alpha = 0.5, F = 1:
+    # 0.57 / 0.25 / 0.13
     dirs, w = sphere_quadrature(400, 400, upper_only=True)
     for mu_v, expected in ((0.1, 0.57), (0.5, 0.25), (1.0, 0.13)):
         v = np.array([np.sqrt(1 - mu_v ** 2), 0.0, mu_v])

@@ -34,7 +34,8 @@ def _cod_albedo(mu_v, r, n=400):
 
 
 def test_cod_directional_albedo_reference_values():
-    # independent numbers from multiscatter.md §5 [computed], given to 2 decimals
+    # independent numbers from docs/multiscattering.md, "Call of Duty WWII diffuse" (computed),
+    # given to 2 decimals
     assert _cod_albedo(0.5, 0.5) == pytest.approx(0.88, abs=0.01)
     assert _cod_albedo(1.0, 0.5) == pytest.approx(0.94, abs=0.01)
     assert _cod_albedo(0.1, 1.0) == pytest.approx(1.05, abs=0.01)

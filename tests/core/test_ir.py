@@ -2,11 +2,12 @@
 import numpy as np
 import pytest
 
-from rt_lookdev.core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter
+from rt_lookdev.core import cloth, diffuse
 from rt_lookdev.core import shading_ops as op
-from rt_lookdev.core.conventions import alpha_from_roughness
 from rt_lookdev.core.ir import Graph, trace
 from rt_lookdev.core.ir.numpy_backend import evaluate, node_count
+from rt_lookdev.validation.grids import TECHNIQUES
+from rt_lookdev.validation.grids import technique_inputs as _inputs
 
 
 def test_common_subexpressions_are_shared():
@@ -71,51 +72,6 @@ def test_numpy_backend_has_blender_semantics():
     n = evaluate(op.normalize(v), {"v": np.array([[0.0, 0.0, 0.0], [3.0, 0.0, 4.0]])})
     assert np.array_equal(n[0], [0, 0, 0]) and np.allclose(n[1], [0.6, 0, 0.8])
     assert evaluate(a, vals).dtype == np.float32                  # Cycles computes in float32
-
-
-# Every shading technique, traced once: the IR evaluated by the numpy backend must equal the
-# direct numpy evaluation of the same function.
-def _ggx(mu_l, mu_v, n_dot_h, v_dot_h, r, f0):
-    return microfacet.ggx_brdf(mu_l, mu_v, n_dot_h, v_dot_h, alpha_from_roughness(r), f0)
-
-
-TECHNIQUES = {
-    "ggx_brdf": (_ggx, ["mu_l", "mu_v", "n_dot_h", "v_dot_h", "r", "f0"]),
-    "fresnel_average": (lambda f0: fresnel.fresnel_average(f0), ["f0"]),
-    "kulla_conty_brdf": (multiscatter.kulla_conty_brdf, ["one_minus_e_o", "one_minus_e_i", "one_minus_e_avg", "f0"]),
-    "turquin": (multiscatter.turquin_compensation, ["f0", "e_v"]),
-    "fdez_aguera": (multiscatter.fdez_aguera_env_brdf, ["f0", "scale", "bias"]),
-    "fdez_aguera_area": (multiscatter.fdez_aguera_area_scale, ["f0", "e"]),
-    "cod_diffuse": (lambda mu_l, mu_v, n_dot_h, l_dot_h, r: diffuse.cod_multiscatter_diffuse(
-        0.8, mu_l, mu_v, n_dot_h, l_dot_h, alpha_from_roughness(r)), ["mu_l", "mu_v", "n_dot_h", "l_dot_h", "r"]),
-    "wrapped_diffuse": (diffuse.wrapped_diffuse_cosine, ["mu_l", "wrap"]),
-    "cloth": (lambda mu_l, mu_v, n_dot_h, r: cloth.ashikhmin_cloth_brdf(mu_l, mu_v, n_dot_h, alpha_from_roughness(r)),
-              ["mu_l", "mu_v", "n_dot_h", "r"]),
-    "disney_sheen": (cloth.disney_sheen, ["l_dot_h"]),
-    "window_falloff": (falloff.window_falloff, ["distance", "radius"]),
-    "inverse_square": (lambda distance: falloff.inverse_square_falloff(distance), ["distance"]),
-    "cone_falloff": (falloff.cone_falloff, ["cos_to_axis", "inner_angle", "outer_angle"]),
-    "projector_distance": (falloff.projector_distance, ["diameter", "outer_angle"]),
-}
-
-
-def _inputs(names, n=4000, seed=0):
-    rng = np.random.default_rng(seed)
-    extremes = np.array([0.0, 1e-7, 1e-4, 0.5, 1.0 - 1e-7, 1.0])
-    vals = {}
-    for i, name in enumerate(names):
-        # cosines also below the horizon; every other parameter in its domain [0, 1]
-        cosine = name.startswith(("mu", "n_dot", "v_dot", "l_dot", "cos"))
-        x = rng.uniform(-0.1 if cosine else 0.0, 1.0, n)
-        x[: extremes.size * 2] = np.concatenate([extremes, np.roll(extremes, i + 1)])
-        if name in ("distance", "radius", "diameter"):
-            x = np.abs(x) * 5
-        if name in ("inner_angle", "outer_angle"):
-            x = np.abs(x) * 3.0
-        if name == "one_minus_e_avg":    # the table's range: 1.3e-5 (r = 0) .. 0.59 (r = 1)
-            x = np.clip(x, 1e-5, 0.6)
-        vals[name] = x
-    return vals
 
 
 @pytest.mark.parametrize("name", sorted(TECHNIQUES))

@@ -23,8 +23,7 @@ X, Y, Z = np.eye(3)
 
 @pytest.fixture(scope="module")
 def tables(lut_dir):
-    with lookup.use_lut_dir(lut_dir):      # the integrals' node functions read the default tables
-        yield lookup.LtcTables(lut_dir)
+    return lookup.LutSet.from_folder(lut_dir)
 
 
 # --- configurations ------------------------------------------------------------------------------
@@ -123,7 +122,7 @@ def _nodes(function):
 def _packed_cases(tables, cfg):
     """Packed matrices: table entries at every configuration's (mu, r), the identity, a random mix."""
     mu = np.clip(cfg["v"][:, 2], 0.0, 1.0)
-    c, _, _ = tables.lookup("ltc_ggx", mu, cfg["r"])
+    c, _, _ = tables.ltc("ltc_ggx", mu, cfg["r"])
     rng = np.random.default_rng(RNG_SEED + 1)
     cases = [np.stack(c, axis=-1),
              np.broadcast_to(np.array(shading.IDENTITY), (len(mu), 4)),
@@ -138,17 +137,17 @@ def test_quad_integral_traced_equals_numpy(tables, dtype):
     corners = np.stack([_quad(c, u, v) for c, u, v in zip(cfg["c"], cfg["u"], cfg["w"])])
     names = dict({f"c{i}": "float" for i in range(4)}, **{f"p{i}": "vector" for i in range(4)},
                  **{"Two Sided": "float"})
-    _, out = trace(lambda **kw: polygon.LTC_QUAD_INTEGRAL(**kw)["Integral"], names)
+    _, out = trace(lambda **kw: polygon.LTC_QUAD_INTEGRAL(tables, **kw)["Integral"], names)
     for packed in _packed_cases(tables, cfg):
         for two in (0.0, 1.0):
             args = {f"c{i}": packed[:, i] for i in range(4)}
             args.update({f"p{i}": corners[:, i] for i in range(4)}, **{"Two Sided": np.full(len(packed), two)})
-            direct = polygon.LTC_QUAD_INTEGRAL(**args)["Integral"]
+            direct = polygon.LTC_QUAD_INTEGRAL(tables, **args)["Integral"]
             # the array API (3x3 Minv) is the same computation
             via_matrix = polygon.ltc_quad_integral(matrix.unpack_inverse(packed), corners, bool(two),
                                                    sphere_table=tables.sphere_table())
             _close(via_matrix, direct, np.float64)
-            _close(evaluate(out, args, dtype), direct, dtype)
+            _close(evaluate(out, args, dtype, tables), direct, dtype)
             assert direct.min() >= 0.0 and direct.max() <= 1.0 + 1e-6
 
 
@@ -157,17 +156,17 @@ def test_disk_integral_traced_equals_numpy(tables, dtype):
     cfg = _configurations()
     names = dict({f"c{i}": "float" for i in range(4)}, **{"Center": "vector", "Axis U": "vector",
                                                          "Axis V": "vector", "Two Sided": "float"})
-    _, out = trace(lambda **kw: disk.LTC_DISK_INTEGRAL(**kw)["Integral"], names)
+    _, out = trace(lambda **kw: disk.LTC_DISK_INTEGRAL(tables, **kw)["Integral"], names)
     for packed in _packed_cases(tables, cfg):
         for two in (0.0, 1.0):
             args = {f"c{i}": packed[:, i] for i in range(4)}
             args.update({"Center": cfg["c"], "Axis U": cfg["u"], "Axis V": cfg["w"],
                          "Two Sided": np.full(len(packed), two)})
-            direct = disk.LTC_DISK_INTEGRAL(**args)["Integral"]
+            direct = disk.LTC_DISK_INTEGRAL(tables, **args)["Integral"]
             via_matrix = disk.ltc_disk_integral(matrix.unpack_inverse(packed), cfg["c"], cfg["u"], cfg["w"],
                                                 bool(two), sphere_table=tables.sphere_table())
             _close(via_matrix, direct, np.float64)
-            _close(evaluate(out, args, dtype), direct, dtype)
+            _close(evaluate(out, args, dtype, tables), direct, dtype)
             assert direct.min() >= 0.0 and direct.max() <= 1.0 + 1e-6
 
 
@@ -226,7 +225,7 @@ def test_shading_traced_equals_numpy(tables, name, kind):
         with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
             direct = shade(**args)
         for dtype in (np.float64, np.float32):
-            _close(evaluate(out, args, dtype), direct, dtype)
+            _close(evaluate(out, args, dtype, tables), direct, dtype)
 
 
 def test_frame_is_shared_between_lobes(tables):

@@ -5,7 +5,9 @@ import numpy as np
 import OpenEXR
 import pytest
 
-from rt_lookdev.core.lut import bake, catalog, exr_io, exr_reader, lookup
+from rt_lookdev.core import lut_bake as bake
+from rt_lookdev.core.ir import semantics
+from rt_lookdev.core.lut import catalog, exr_io, exr_reader, lookup
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -153,18 +155,18 @@ def test_docs_describe_every_table():
 def test_bilinear_sampling_reconstructs_nodes_and_extends():
     table = np.arange(4 * 3 * 4, dtype=np.float64).reshape(4, 3, 4)
     j, i = np.meshgrid(np.arange(4), np.arange(3), indexing="ij")
-    got = lookup.sample_bilinear(table, (i + 0.5) / 3, (j + 0.5) / 4)
+    got = semantics.sample_bilinear(table, (i + 0.5) / 3, (j + 0.5) / 4)
     assert np.array_equal(got, table)
-    assert np.array_equal(lookup.sample_bilinear(table, -1.0, 2.0), table[3, 0])       # EXTEND
-    mid = lookup.sample_bilinear(table, 1.0 / 3, 0.5 / 4)                                 # halfway in u
+    assert np.array_equal(semantics.sample_bilinear(table, -1.0, 2.0), table[3, 0])       # EXTEND
+    mid = semantics.sample_bilinear(table, 1.0 / 3, 0.5 / 4)                                 # halfway in u
     assert np.allclose(mid, 0.5 * (table[0, 0] + table[0, 1]))
     x = np.linspace(0, 1, 7)
     assert np.allclose(lookup.lut_coordinate(x, 64) * 64 - 0.5, x * 63)
 
 
 def test_energy_lut_matches_cycles_nodes(energy_tables):
-    from rt_lookdev.core import validation
-    result = validation.cycles_table_comparison(energy_tables)
+    from rt_lookdev.core import energy_checks
+    result = energy_checks.cycles_table_comparison(energy_tables)
     assert result["max_abs_diff_E_lut"] < 1e-3 and result["max_abs_diff_E_avg_lut"] < 1e-3
     assert result["E_avg_r1_lut"] == pytest.approx(0.409, abs=1e-3)
 
@@ -177,3 +179,17 @@ def test_writing_without_openexr_uses_the_pure_writer(tmp_path, monkeypatch):
     got, meta = exr_io.read_table(tmp_path / "x.exr")
     np.testing.assert_array_equal(got, table)
     assert meta["table"] == "x"
+
+
+def test_inputs_hash_sees_code_not_comments(tmp_path):
+    """Editing a comment or a docstring of a source module leaves the tables current; editing code
+    makes them stale (``catalog.code_text``)."""
+    src = '"""Module doc."""\nimport math  # a comment\n\n\ndef f(x):\n    """Doc."""\n    # note\n    return x * 2  # why\n'
+    a = tmp_path / "a.py"
+    a.write_text(src)
+    base = catalog.code_text(a)
+    assert "comment" not in base and "Doc" not in base and "return x * 2" in base
+    a.write_text(src.replace("a comment", "another comment").replace('"""Doc."""', '"""Other\n    doc."""'))
+    assert catalog.code_text(a) == base
+    a.write_text(src.replace("x * 2", "x * 3"))
+    assert catalog.code_text(a) != base

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from rt_lookdev.core import energy, microfacet
-from rt_lookdev.core.validation import CYCLES_E, CYCLES_E_AVG, CYCLES_MU, CYCLES_R
+from rt_lookdev.core.energy_checks import CYCLES_E, CYCLES_E_AVG, CYCLES_MU, CYCLES_R
 from rt_lookdev.core import shading_ops as op
 
 from quadrature import projected_area, sphere_quadrature

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from rt_lookdev.core import energy, multiscatter, validation
+from rt_lookdev.core import energy, energy_checks, multiscatter
 
 ROUGHNESS = np.linspace(0.0, 1.0, 11)
 MU_O = np.linspace(0.1, 1.0, 10) + 0.013   # off the table nodes
@@ -10,7 +10,7 @@ MU_O = MU_O[MU_O <= 1.0]
 
 def test_kulla_conty_white_furnace(energy_tables):
     # E_ss (true integral, off-node mu) + E_ms (lobe built from the LUTs) = 1 for F = 1.
-    assert np.max(np.abs(validation.kulla_conty_furnace(energy_tables, ROUGHNESS, MU_O))) < 1e-3
+    assert np.max(np.abs(energy_checks.kulla_conty_furnace(energy_tables, ROUGHNESS, MU_O))) < 1e-3
 
 
 def test_ms_albedo_quadrature_on_a_constant_lobe():
@@ -22,7 +22,7 @@ def test_ms_albedo_quadrature_on_a_constant_lobe():
         def one_minus_e_avg(self, r):
             return np.full(np.shape(r), 0.3)
 
-    assert validation.kulla_conty_ms_albedo(Constant(), 0.5, 0.5) == pytest.approx(0.3, rel=1e-9)
+    assert energy_checks.kulla_conty_ms_albedo(Constant(), 0.5, 0.5) == pytest.approx(0.3, rel=1e-9)
 
 
 def test_lut_e_avg_is_consistent_with_lut_e(energy_tables):
@@ -68,7 +68,7 @@ def test_turquin_white_furnace_and_non_reciprocity(energy_tables):
 
 
 def test_fdez_aguera_white_furnace_every_cell(energy_tables):
-    scale, bias = energy_tables.tables["ggx_split_sum"][..., 0], energy_tables.tables["ggx_split_sum"][..., 1]
+    scale, bias = energy_tables.array("ggx_split_sum")[..., 0], energy_tables.array("ggx_split_sum")[..., 1]
     assert np.allclose(multiscatter.fdez_aguera_env_brdf(1.0, scale.astype(np.float64), bias), 1.0, atol=1e-6)
     # coloured: more than single scattering, at most 1
     single = multiscatter.split_sum_specular(0.5, scale, bias)
@@ -77,15 +77,15 @@ def test_fdez_aguera_white_furnace_every_cell(energy_tables):
 
 
 def test_split_sum_sums_to_e(energy_tables):
-    scale, bias = energy_tables.tables["ggx_split_sum"][..., 0], energy_tables.tables["ggx_split_sum"][..., 1]
-    one_minus_e = energy_tables.tables["ggx_one_minus_E"][..., 0]
+    scale, bias = energy_tables.array("ggx_split_sum")[..., 0], energy_tables.array("ggx_split_sum")[..., 1]
+    one_minus_e = energy_tables.array("ggx_one_minus_E")[..., 0]
     assert np.allclose(scale + bias, 1.0 - one_minus_e, atol=2e-7)
     assert np.all(bias >= 0) and np.all(scale >= 0)
 
 
 def test_talk_polynomial_breaks_furnace_at_low_roughness(energy_tables):
     # The talk's AverageEnergy fit clamps to 0.999; mixed with the tabulated E it breaks the
-    # furnace identity (multiscatter.md §6.3).  The table's own E_avg does not.
+    # furnace identity (docs/multiscattering.md, "Reference numbers").  The table's own E_avg does not.
     r, mu = 0.2, 0.2
     one_minus_e_o = energy_tables.one_minus_e(np.array([mu]), np.array([r]))[0]
     e_avg_true = energy_tables.e_avg(np.array([r]))[0]
@@ -93,4 +93,4 @@ def test_talk_polynomial_breaks_furnace_at_low_roughness(energy_tables):
     e_ms_poly = one_minus_e_o * (1 - e_avg_true) / (1 - e_avg_poly)
     furnace_poly = (1 - one_minus_e_o) + e_ms_poly
     assert abs(furnace_poly - 1) > 0.05
-    assert abs((1 - one_minus_e_o) + validation.kulla_conty_ms_albedo(energy_tables, mu, r) - 1) < 1e-4
+    assert abs((1 - one_minus_e_o) + energy_checks.kulla_conty_ms_albedo(energy_tables, mu, r) - 1) < 1e-4

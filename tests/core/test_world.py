@@ -1,4 +1,4 @@
-"""The RT Lit World term (core/materials/world.py) in numpy and traced.
+"""The RT Lit World term (core/materials/world_shading.py) in numpy and traced.
 
 - furnace: a uniform white environment with F0 = 1 gives 1 for every multiscattering model (and the
   split-sum albedo E for the single-scattering one);
@@ -17,21 +17,24 @@ import pytest
 
 from rt_lookdev.core import indirect
 from rt_lookdev.core.environment import prefilter, sh
-from rt_lookdev.core.ir import Graph
-from rt_lookdev.core.ir.expr import FLOAT, VECTOR
-from rt_lookdev.core.ir.numpy_backend import evaluate, node_count
+from rt_lookdev.core.ir.numpy_backend import node_count
 from rt_lookdev.core.lut import lookup
-from rt_lookdev.core.materials import rt_lit, world
+from rt_lookdev.core.materials import rt_lit
+from rt_lookdev.core.materials import world_shading as world
 from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS, Features
 
 LEVELS = tuple(k / 8.0 for k in range(9))
 MAX_NODES = 144
 
 
+TABLES = {}
+
+
 @pytest.fixture(scope="module", autouse=True)
 def _tables(lut_dir):
-    with lookup.use_lut_dir(lut_dir):
-        yield
+    TABLES["luts"] = lookup.LutSet.from_folder(lut_dir)
+    yield
+    TABLES.clear()
 
 
 def _env_from_levels(levels, name):
@@ -84,7 +87,7 @@ def _params(coeffs, strength=1.0, rotation=(0.0, 0.0, 0.0)):
 
 def _radiance(features, env, params, m, normals, views):
     geo = {"Position": np.zeros(3), "Geometry Normal": normals, "Incoming": views}
-    return rt_lit.rt_lit_radiance(features, m, geo, [], world=(env, params))
+    return rt_lit.rt_lit_radiance(TABLES["luts"], features, m, geo, [], world=(env, params))
 
 
 ALL_FEATURES = [Features(s, d, sheen, cloth, form)
@@ -111,7 +114,7 @@ def test_white_furnace_multiscattering_is_one():
                 np.testing.assert_allclose(out, 1.0, atol=1e-9, err_msg=f"{spec} {form} r={r}")
         single = _radiance(Features("single", "lambert"), env, _params(coeffs), m, normals, views)
         mu = np.clip(np.sum(normals * views, -1), 0.0, 1.0)
-        a, b = world.split_sum(mu, r)
+        a, b = TABLES["luts"].split_sum(mu, r)
         np.testing.assert_allclose(single, np.repeat((a + b)[:, None], 3, 1), atol=1e-9)
         assert single.min() < 0.999 or r == 0.0     # single scattering loses energy
 
@@ -183,7 +186,7 @@ def test_dielectric_and_metal_are_shaded_separately():
     # ... which differs from shading one mixed F0 (the bug this avoids): Turquin at metallic 0.5
     r = 0.8
     mu = np.clip(np.sum(normals * views, -1), 0.0, 1.0)
-    a, b = world.split_sum(mu, r)
+    a, b = TABLES["luts"].split_sum(mu, r)
     f0_d, f0_m = 0.04, 1.0
     channel = world._channel_specular("turquin", "irradiance")
     separate = 0.5 * channel(f0_d, a, b, 1.0, 1.0, 0.0) + 0.5 * channel(f0_m, a, b, 1.0, 1.0, 0.0)
@@ -191,7 +194,7 @@ def test_dielectric_and_metal_are_shaded_separately():
     assert np.max(np.abs(mixed / separate - 1.0)) > 0.1
 
 
-def test_diffuse_models_equal_core_indirect(lut_dir):
+def test_diffuse_models_equal_core_indirect():
     rng = np.random.default_rng(6)
     env = _random_env(rng)
     coeffs = rng.normal(size=(9, 3))
@@ -201,24 +204,13 @@ def test_diffuse_models_equal_core_indirect(lut_dir):
     m = _material(rng, n, **{"Metallic": 0.0, "Cloth Weight": np.ones(n), "Cloth Color": np.zeros(3),
                              "Sheen Weight": 0.0, "Roughness": 0.4, "Wrap": 0.3})
     albedo = np.asarray(m["Base Color"])
-    tables = lookup.LtcTables(lut_dir)
+    tables = TABLES["luts"]
     want = {"lambert": indirect.sh_lambert(list(coeffs), normals, albedo),
             "wrapped": indirect.sh_wrapped_diffuse(list(coeffs), normals, albedo, 0.3),
             "cod": indirect.sh_cod_diffuse(tables, list(coeffs), normals, views, 0.4, albedo)}
     for diffuse, expected in want.items():
         got = _radiance(Features("single", diffuse, cloth=True), env, _params(coeffs), m, normals, views)
         np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-12, err_msg=diffuse)
-
-
-def _trace_world(features, env):
-    g = Graph()
-    material = {name: g.input(name, FLOAT if sock.kind == "float" else VECTOR) for name, sock in RT_LIT_INPUTS.items()}
-    geometry = {name: g.input(name, VECTOR) for name in ("Position", "Geometry Normal", "Incoming")}
-    params = {f"SH {i}": g.input(f"World SH {i}", VECTOR) for i in range(9)}
-    params["Strength"] = g.input("World Strength", FLOAT)
-    params["Rotation"] = g.input("World Rotation", VECTOR)
-    out = rt_lit.rt_lit_radiance(features, material, geometry, [], world=(env, params))
-    return g, out
 
 
 @pytest.mark.parametrize("features", ALL_FEATURES, ids=lambda f: f.label())
@@ -232,14 +224,14 @@ def test_traced_world_equals_numpy(features):
     m = _material(rng, n)
     params = _params(coeffs, 1.7, (0.2, -0.4, 1.3))
     want = _radiance(features, env, params, m, normals, views)
-    _, out = _trace_world(features, env)
+    material = rt_lit.build_rt_lit(features, (), env)          # the whole material as the node groups get it
     inputs = dict(m, Position=np.zeros((n, 3)), **{"Geometry Normal": normals, "Incoming": views})
-    inputs.update({f"World {k}": (np.broadcast_to(v, (n, 3)) if np.ndim(v) else np.full(n, v))
+    inputs.update({material.world_inputs[k]: (np.broadcast_to(v, (n, 3)) if np.ndim(v) else np.full(n, v))
                    for k, v in params.items()})
     inputs["Normal"] = np.zeros((n, 3))
-    got64 = evaluate(out, inputs, np.float64)
+    got64 = material.evaluate(inputs, TABLES["luts"], np.float64)["Radiance"]
     np.testing.assert_allclose(got64, want, rtol=2e-6, atol=1e-9)   # as test_ltc_trace (float32 tables)
-    got32 = evaluate(out, inputs, np.float32)
+    got32 = material.evaluate(inputs, TABLES["luts"], np.float32)["Radiance"]
     assert np.all(np.isfinite(got32))
     np.testing.assert_allclose(got32, want, rtol=1e-4, atol=1e-5)
 

@@ -30,16 +30,17 @@ cloth x w = 0), and its diffuse by Metallic 1 (albedo 0).
 """
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass, field
+from typing import ClassVar
 from pathlib import Path
 
 import numpy as np
 
-import _bootstrap  # noqa: F401
 
-from rt_lookdev.core.materials.rt_lit_interface import Features
+from ..core.materials.rt_lit_interface import Features
 
 # --- case description -----------------------------------------------------------------------
 
@@ -93,20 +94,23 @@ def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
     return m
 
 
-@dataclass
+@dataclass(frozen=True)
 class Variant:
+    """One sphere of a case: a technique (a key of ``techniques``: (features, truth, text)) and its
+    material values.  The world validation's variants (world_cases.WorldVariant) share it."""
     technique: str
     roughness: float = 0.5
     color: tuple | None = None
     wrap: float = 0.5
+    techniques: ClassVar[dict] = TECHNIQUES
 
     @property
     def features(self):
-        return TECHNIQUES[self.technique][0]
+        return self.techniques[self.technique][0]
 
     @property
     def truth(self):
-        return TECHNIQUES[self.technique][1]
+        return self.techniques[self.technique][1]
 
     @property
     def label(self):
@@ -281,8 +285,8 @@ def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
     """Reset the file; lights, spheres with RT Lit materials, camera.  Returns (scene, spheres)."""
     import bpy
 
-    import validate_energy
-    from rt_lookdev.addon import materials
+    from . import energy_render as validate_energy
+    from ..addon import materials
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
@@ -355,19 +359,18 @@ def sphere_index(case, position, normal):
 # --- (b) numpy -------------------------------------------------------------------------------
 
 def scene_light_params(scene):
-    from rt_lookdev.addon import materials
+    from ..addon import materials
 
     return [(kind, materials.light_parameters(obj, kind)) for obj, kind in materials.scene_lights(scene)]
 
 
-def _numpy_material(variant):
-    from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS
+def numpy_material(variant):
+    """RT_LIT_INPUTS name -> the variant's value (the socket default where the variant sets none)."""
+    from ..core.materials.rt_lit_interface import RT_LIT_INPUTS
 
     out = {}
     for name, sock in RT_LIT_INPUTS.items():
-        v = sock.default
-        if name in variant.material():
-            v = variant.material()[name]
+        v = variant.material().get(name, sock.default)
         if sock.kind == "float":
             out[name] = float(v)
         elif name == "Normal":
@@ -377,31 +380,56 @@ def _numpy_material(variant):
     return out
 
 
-def numpy_radiance(case, scene, passes, index, dtype=np.float32):
-    """(b): the RT Lit materials' IR (the graph the node groups are emitted from) evaluated by the
-    numpy backend at the render's pixels, in float32 with Cycles' node semantics (float64 on request)."""
-    from engine_parity import camera_incoming
-    from rt_lookdev.addon import materials
-    from rt_lookdev.core.ir import Graph
-    from rt_lookdev.core.ir.numpy_backend import evaluate
-    from rt_lookdev.core.materials import rt_lit
+def material_values(material):
+    """Inputs of the RT Lit function from a material's RT Lit node (``materials.material_parameters``)."""
+    from ..addon import materials
+
+    return {k: (np.array(v) if isinstance(v, tuple) else v) for k, v in materials.material_parameters(material).items()}
+
+
+def numpy_radiance(scene, variants, objects, passes, index, tables, world=None, dtype=np.float32):
+    """(b): each sphere's RT Lit material, the core function the node groups are emitted from
+    (``core.materials.rt_lit.build_rt_lit`` for its features, the scene's lights and the world), evaluated
+    by the numpy backend at the render's Position / Normal passes with the material node's values, the
+    lights' driver values and the world's parameters; float32 with Cycles' node semantics (float64 on
+    request).  ``objects[i]`` carries variant i's material; ``world``: None or (WorldEnvironment, params)."""
+    from ..core.materials import rt_lit
+    from .engines import camera_incoming
 
     pos = passes["Position"].astype(np.float64)
     nrm = passes["Normal"].astype(np.float64)
     out = np.zeros(pos.shape)
     lights = scene_light_params(scene)
-    for i, variant in enumerate(case.variants):
+    env, world_params = world if world is not None else (None, {})
+    for i, variant in enumerate(variants):
         mine = index == i
         if not mine.any():
             continue
-        mat = scene.objects[f"RTL_val_sphere_{i}"].data.materials[0]
-        params = {k: (np.array(v) if isinstance(v, tuple) else v)
-                  for k, v in materials.material_parameters(mat).items()}
-        geo = {"Position": pos[mine], "Geometry Normal": nrm[mine], "Incoming": camera_incoming(scene, pos[mine])}
-        g = Graph()
-        traced = rt_lit.rt_lit_radiance(variant.features, params, {k: g.input(k, "vector") for k in geo}, lights)
-        out[mine] = evaluate(traced, geo, dtype)
+        material = rt_lit.build_rt_lit(variant.features, tuple(kind for kind, _ in lights), env)
+        values = material_values(objects[i].data.materials[0])
+        values.update({"Position": pos[mine], "Geometry Normal": nrm[mine],
+                       "Incoming": camera_incoming(scene, pos[mine])})
+        for names, (_, params) in zip(material.light_inputs, lights):
+            values.update({names[p]: params[p] for p in names})
+        values.update({material.world_inputs[p]: v for p, v in world_params.items()})
+        out[mine] = material.evaluate(values, tables, dtype)["Radiance"]
     return out
+
+
+def conditioning(fn, passes, b=None):
+    """(b) = fn(passes, float32) (computed unless given) and, per value, how far float32 rounding moves
+    it: the float64 evaluation moved by one float32 ulp of position and normal (random signs), and
+    float32 vs float64 at both positions (its internal rounding)."""
+    b = fn(passes, np.float32) if b is None else b
+    b64 = fn(passes, np.float64)
+    moved = dict(passes)
+    signs = np.random.default_rng(17)
+    for key in ("Position", "Normal"):
+        x = passes[key].astype(np.float32)
+        moved[key] = np.nextafter(x, np.where(signs.random(x.shape) < 0.5, -np.inf, np.inf).astype(np.float32))
+    b64_moved = fn(moved, np.float64)
+    b32_moved = fn(moved, np.float32)
+    return b, np.maximum.reduce([np.abs(b - b64), np.abs(b64_moved - b64), np.abs(b32_moved - b64_moved)])
 
 
 # --- (c) Cycles ground truth -----------------------------------------------------------------
@@ -449,7 +477,7 @@ def _closure_material(variant, name):
     elif t == "metal":
         shader = metallic(m["Base Color"])
     elif t == "dielectric":
-        from rt_lookdev.core.materials.rt_lit import dielectric_f0
+        from ..core.materials.surface import dielectric_f0
 
         f0 = float(dielectric_f0(np.float64(m["IOR"]), np.float64(m["Specular IOR Level"])))
         add = nt.nodes.new("ShaderNodeAddShader")
@@ -463,7 +491,7 @@ def _closure_material(variant, name):
 
 
 def configure_truth_render(scene, samples, seed, threads=2):
-    from rt_lookdev.addon.render_setup import configure_cycles_measurement
+    from .render_setup import configure_cycles_measurement
 
     configure_cycles_measurement(scene, samples, seed, threads)
     c = scene.cycles
@@ -485,9 +513,7 @@ def configure_truth_render(scene, samples, seed, threads=2):
 def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
     """(c) for the Cycles-closure variants: one render per seed.  Returns ([rgb per seed], seconds
     per seed, normal) or None when no variant uses Cycles."""
-    import bpy
-
-    import validate_energy
+    from . import energy_render as validate_energy
 
     todo = [i for i, v in enumerate(case.variants) if v.truth == "cycles"]
     if not todo:
@@ -518,7 +544,7 @@ def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
 # --- (c) brute-force ground truth -------------------------------------------------------------
 
 def _area_geometry(kind, params):
-    from rt_lookdev.core import lights as core_lights
+    from ..core import lights as core_lights
 
     out = core_lights.LIGHT_DATA[kind](**{k: np.float64(v) for k, v in params.items()})
     out = {k: np.asarray(v, np.float64) for k, v in out.items()}
@@ -529,7 +555,7 @@ def _area_geometry(kind, params):
 
 def _rule(kind, geo, p, clip_normal, panels, order):
     """Points relative to p (M, 3), area weights (M,), unit light normal, or None if unlit."""
-    from rt_lookdev.core.ltc import reference
+    from ..core.ltc import reference
 
     if kind == "quad":
         rel = geo["corners"] - p
@@ -547,22 +573,23 @@ def _rule(kind, geo, p, clip_normal, panels, order):
 
 
 def _surface(features, material, n, v):
-    from rt_lookdev.core.materials import rt_lit
-    from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS
+    from ..core.materials.rt_lit_interface import RT_LIT_INPUTS
+    from ..core.materials.surface import SURFACE
 
-    return rt_lit.SURFACE(**{k: material[k] for k in RT_LIT_INPUTS}, **{"Geometry Normal": n, "Incoming": v})
+    return SURFACE(**{k: material[k] for k in RT_LIT_INPUTS}, **{"Geometry Normal": n, "Incoming": v})
 
 
-def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, panels=8, order=8, only=None, chunk=24):
+def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, panels=8, order=8, only=None,
+                         chunk=24):
     """(c) for the brute-force variants on at most ``pixel_cap`` seeded pixels per sphere.
 
     Returns (image with NaN where not computed, quadrature error estimate image, seconds per
     variant).  The error estimate is |I(panels) - I(panels / 2)| (reference._converged's check).
     Pixels are evaluated in chunks: the rule's points of ``chunk`` pixels go through one call of
-    the shading function (numpy, float64)."""
-    from engine_parity import camera_incoming
-    from rt_lookdev.core import lights as core_lights
-    from rt_lookdev.core.materials import rt_lit
+    the shading function (numpy, float64; ``tables`` the LUT set the punctual GGX reads E from)."""
+    from ..core import lights as core_lights
+    from ..core.materials import light_shading
+    from .engines import camera_incoming
 
     pos = passes["Position"].astype(np.float64)
     nrm = passes["Normal"].astype(np.float64)
@@ -580,8 +607,8 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, panels=8, o
             pick = np.sort(rng.choice(len(ys), pixel_cap, replace=False))
             ys, xs = ys[pick], xs[pick]
         features = variant.features
-        material = _numpy_material(variant)
-        shade = rt_lit.shade_function("sun", features)
+        material = numpy_material(variant)
+        shade = functools.partial(light_shading.shade_function("sun", features), tables)
         unclipped = features.diffuse == "wrapped"
         P = pos[ys, xs]
         N = nrm[ys, xs] / np.linalg.norm(nrm[ys, xs], axis=-1, keepdims=True)
@@ -627,7 +654,7 @@ def _shade(shade, surface, owner, l, irradiance):
     """The material's punctual shading (radiance, (M, 3)) for directions l (M, 3) with irradiance
     (M, 3); surface values per pixel, ``owner`` the pixel of each direction."""
     kw = {}
-    for name in shade.input_sockets:
+    for name in shade.func.input_sockets:
         if name == "L":
             kw[name] = l
         elif name == "Irradiance":

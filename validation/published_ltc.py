@@ -1,10 +1,10 @@
 """Load the published GGX LTC table of selfshadow/ltc_code (for comparisons only; never shipped).
 
 The anchor file (../shared/anchors/ltc_code_ggx_table.txt, a sibling of the repository) holds two
-sections of 4096 lines "t a c0 c1 c2 c3" (its header documents the layout; ltc.md §1.4):
-ltc_1 = packed Minv (c0 = Minv_xx, c1 = Minv_zx, c2 = Minv_xz, c3 = Minv_zz), ltc_2 =
-(magnitude, fresnel, 0, sphere table on its own axes).  t is the view axis (sqrt(1 - cos theta)),
-a the roughness axis.
+sections of 4096 lines "t a c0 c1 c2 c3" (its header documents the layout; docs/area_lights.md,
+"Table layout"): ltc_1 = packed Minv (c0 = Minv_xx, c1 = Minv_zx, c2 = Minv_xz,
+c3 = Minv_zz), ltc_2 = (magnitude, fresnel, 0, sphere table on its own axes).  t is the view
+axis (sqrt(1 - cos theta)), a the roughness axis.
 """
 from __future__ import annotations
 

@@ -8,19 +8,24 @@ from pathlib import Path
 
 import numpy as np
 
-import _png
+from . import exr_images
+from . import png as _png
+
+
+def json_default(o):
+    """``json.dumps(default=...)`` for numpy scalars and arrays and paths."""
+    if isinstance(o, (np.bool_, np.integer, np.floating)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, Path):
+        return str(o)
+    raise TypeError(f"not JSON serialisable: {type(o)}")
 
 
 def write_exr(path, rgb):
     """(H, W, 3) float image (row 0 = top) as a 32-bit float RGB EXR; NaN written as 0."""
-    import OpenEXR
-
-    rgb = np.nan_to_num(np.asarray(rgb, np.float32), nan=0.0)
-    channels = {"RGB": np.ascontiguousarray(rgb)}
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-    with OpenEXR.File(header, channels) as f:
-        f.write(str(path))
-    return path
+    return exr_images.write_rgb(path, rgb)
 
 
 def preview_png(path, rgb, scale_value):

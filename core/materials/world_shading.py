@@ -42,10 +42,13 @@ lerp(N, R, s (sqrt(s) + alpha)) with s = 1 - alpha, alpha = r^2, R the mirror di
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from pathlib import Path
 
 from .. import indirect, multiscatter
 from .. import shading_ops as op
@@ -53,8 +56,10 @@ from ..conventions import alpha_from_roughness
 from ..fresnel import fresnel_average
 from ..ir.functions import NodeFunction
 from ..ir.interface import Socket, color, factor, vector
-from ..lut.lookup import energy_lut_uv
-from . import lobes
+from ..ir.tables import Table
+from ..ltc import polygon
+from ..lut.lookup import REFERENCES
+from .rt_lit_interface import SURFACE_OUTPUTS, world_input
 
 PI = math.pi
 
@@ -79,10 +84,12 @@ SHEEN_TABLE_ROUGHNESS = 0.5       # the talk's sheen: the CoD table at r = 0.5 (
 @dataclass(frozen=True)
 class WorldEnvironment:
     """A baked environment as shading code needs it: the prefiltered levels as one table (the EXR's
-    rows, Blender order: row 0 at the bottom; level k in rows [k H, (k + 1) H)) and their roughness."""
+    rows, Blender order: row 0 at the bottom; level k in rows [k H, (k + 1) H)) and their roughness;
+    ``source``: the EXR file it was read from (None when it came from elsewhere, e.g. a packed image)."""
     name: str                 # table / image name, e.g. env_<content hash>
     table: np.ndarray         # (L H, W, 4) float32
     roughness_levels: tuple
+    source: object = None
 
     @classmethod
     def load(cls, prefiltered_path, name):
@@ -92,7 +99,7 @@ class WorldEnvironment:
 
         table, meta = exr_io.read_table(prefiltered_path)
         levels = tuple(float(r) for r in json.loads(meta["roughness_levels"]))
-        return cls(name, np.asarray(table, np.float32), levels)
+        return cls(name, np.asarray(table, np.float32), levels, Path(prefiltered_path))
 
     @classmethod
     def from_bake(cls, bake):
@@ -106,16 +113,24 @@ class WorldEnvironment:
         if self.table.shape[0] % len(levels):
             raise ValueError(f"prefiltered table of {self.table.shape[0]} rows is not {len(levels)} levels")
 
-    @property
-    def lut(self):
-        return op.Lut(self.name, self.table)
+    def as_table(self):
+        """The prefiltered levels as a table of a table set (``core.ir.tables.Table``)."""
+        return Table.from_array(self.name, self.table, self.source)
+
+    @functools.cached_property
+    def digest(self):
+        """SHA-1 of the table's bytes: two environments are equal (and share traced functions) only when
+        their data are."""
+        return hashlib.sha1(np.ascontiguousarray(self.table, np.float32).tobytes()).hexdigest()
+
+    def _key(self):
+        return (self.name, self.table.shape, self.roughness_levels, self.digest)
 
     def __hash__(self):
-        return hash((self.name, self.table.shape, self.roughness_levels))
+        return hash(self._key())
 
     def __eq__(self, other):
-        return isinstance(other, WorldEnvironment) and (self.name, self.table.shape, self.roughness_levels) == \
-            (other.name, other.table.shape, other.roughness_levels)
+        return isinstance(other, WorldEnvironment) and self._key() == other._key()
 
 
 def _wrap(t):
@@ -126,9 +141,9 @@ def _wrap(t):
 # Blender's equirectangular mapping (core/environment/equirect.py, Cycles direction_to_equirectangular):
 # u = 0.5 - atan2(y, x) / (2 pi), v = 1 - acos(z) / pi.  Bilinear within a level (REPEAT in u, rows
 # clamped to the level), linear across the two levels around r: 8 exact Closest fetches (EEVEE's Linear
-# filtering picks mipmaps from screen-space derivatives; core/shading_ops.lut_sample).
+# filtering picks mipmaps from screen-space derivatives; core/ir/tables.py).
 def _prefiltered_body(env):
-    lut = env.lut
+    lut = env.as_table()
     n_levels = len(env.roughness_levels)
     h = env.table.shape[0] // n_levels
     w = env.table.shape[1]
@@ -221,14 +236,9 @@ def sh_lobe(coeffs, axis, zonal):
     return SH_LOBE(**kw, Axis=axis, **{"Lambda 1": zonal[1], "Lambda 2": zonal[2]})["Radiance"]
 
 
-def _ltc_axis_and_magnitude(table, n, v, roughness):
-    from ..lut import lookup
-
-    tables = lookup.default_ltc_tables()
+def _ltc_axis_and_magnitude(tables, table, n, v, roughness):
     mu = op.saturate(op.dot(n, v))
-    c, magnitude, fresnel = tables.lookup(table, mu, roughness)
-    from ..ltc import polygon
-
+    c, magnitude, fresnel = tables.ltc(table, mu, roughness)
     axis = indirect.ltc_lobe_axis(c, polygon.local_frame(n, v), "talk")
     return axis, magnitude, fresnel
 
@@ -236,9 +246,9 @@ def _ltc_axis_and_magnitude(table, n, v, roughness):
 # The talk, "LTCs for Spherical Harmonics": the cosine lobe rotated by the LTC inverse matrix of the
 # BRDF (axis c1 T1 + c3 N), evaluated against the SH, scaled by the LTC magnitude.
 def _ltc_lobe_function(title, table, description, fixed_roughness=None, use_fresnel=False):
-    def body(**kw):
+    def body(tables, **kw):
         r = fixed_roughness if fixed_roughness is not None else kw["Roughness"]
-        axis, magnitude, fresnel = _ltc_axis_and_magnitude(table, kw["N"], kw["V"], r)
+        axis, magnitude, fresnel = _ltc_axis_and_magnitude(tables, table, kw["N"], kw["V"], r)
         amount = fresnel * PI if use_fresnel else magnitude
         return {"Axis": op.normalize(axis), "Magnitude": amount}
 
@@ -247,7 +257,8 @@ def _ltc_lobe_function(title, table, description, fixed_roughness=None, use_fres
         inputs["Roughness"] = factor(0.5, "Blender roughness r")
     return NodeFunction(f"RTL SH-LTC {title}", body, inputs,
                         {"Axis": vector("Cosine lobe axis, unit", "NONE"),
-                         "Magnitude": Socket("float", 0.0, description="Scale of the lobe")}, description)
+                         "Magnitude": Socket("float", 0.0, description="Scale of the lobe")}, description,
+                        tables=REFERENCES)
 
 
 SH_LTC_COD = _ltc_lobe_function("CoD Diffuse", COD_TABLE, "The CoD WWII diffuse's LTC: lobe axis and magnitude")
@@ -257,13 +268,6 @@ SH_LTC_SHEEN = _ltc_lobe_function("Sheen", COD_TABLE, "Disney sheen as the talk:
 
 
 # --- specular ---------------------------------------------------------------------------------------
-
-def split_sum(mu_v, roughness):
-    """(scale A, bias B) of the split-sum environment BRDF at (mu_v, r) (table ggx_split_sum)."""
-    u, v = energy_lut_uv(mu_v, roughness)
-    lut = lobes.energy_lut("ggx_split_sum")
-    return op.lut_sample(lut, u, v, 0), op.lut_sample(lut, u, v, 1)
-
 
 def _channel_specular(model, environment_ms):
     """Per colour channel: f0, A, B, P, I (floats) -> outgoing specular radiance (module docstring)."""
@@ -289,8 +293,8 @@ def specular_function(model, environment_ms="irradiance"):
     """``RTL World Specular (<model>)``: one F0's specular under the environment."""
     channel = _channel_specular(model, environment_ms)
 
-    def body(**kw):
-        om_avg = lobes.one_minus_e_avg(kw["Roughness"]) if model == "kulla_conty" else 0.0
+    def body(tables, **kw):
+        om_avg = tables.one_minus_e_avg(kw["Roughness"]) if model == "kulla_conty" else 0.0
         parts = [channel(op.component(kw["F0"], c), kw["Scale"], kw["Bias"], op.component(kw["Prefiltered"], c),
                          op.component(kw["Irradiance"], c), om_avg) for c in range(3)]
         return {"Specular": op.vec3(*parts)}
@@ -305,7 +309,7 @@ def specular_function(model, environment_ms="irradiance"):
     label = model.replace("_", "-") + (f", {environment_ms} form" if model == "fdez_aguera" else "")
     return NodeFunction(f"RTL World Specular ({label})", body, inputs,
                         {"Specular": color((0.0, 0.0, 0.0), "Outgoing specular radiance")},
-                        f"Split-sum specular under the environment, {label}")
+                        f"Split-sum specular under the environment, {label}", tables=REFERENCES)
 
 
 def dominant_direction(n, v, roughness):
@@ -323,11 +327,11 @@ WORLD_SURFACE = ("N", "V", "Roughness", "Dielectric F0", "Metal F0", "Metallic",
                  "Sheen Color", "Cloth Weight", "Cloth Color")
 
 
-def world_radiance(features, env, surface, params):
+def world_radiance(tables, features, env, surface, params):
     """Radiance towards the viewer from the environment (3-vector).
 
     ``surface``: RTL Surface outputs (at least ``WORLD_SURFACE``); ``params``: ``WORLD_PARAMETERS``
-    names -> values; ``env``: the ``WorldEnvironment``."""
+    names -> values; ``env``: the ``WorldEnvironment``; ``tables``: the LUT set (``lookup.LutSet``)."""
     rotated = WORLD_ROTATION(N=surface["N"], V=surface["V"], Rotation=params["Rotation"])
     n, v = rotated["N"], rotated["V"]
     coeffs = [params[name] for name in SH_NAMES]
@@ -340,27 +344,27 @@ def world_radiance(features, env, surface, params):
     elif features.diffuse == "wrapped":
         diffuse = sh_lobe(coeffs, n, indirect.wrapped_lobe_zonal(surface["Wrap"]))
     else:
-        lobe = SH_LTC_COD(N=n, V=v, Roughness=r)
+        lobe = SH_LTC_COD(tables, N=n, V=v, Roughness=r)
         diffuse = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
 
     # specular, per F0, then mixed
-    scale_a, bias_b = split_sum(op.saturate(op.dot(n, v)), r)
+    scale_a, bias_b = tables.split_sum(op.saturate(op.dot(n, v)), r)
     prefiltered = prefiltered_function(env)(Direction=dominant_direction(n, v, r), Roughness=r)["Radiance"]
     spec_fn = specular_function(features.specular, getattr(features, "environment_ms", "irradiance"))
     extra = {"Roughness": r} if features.specular == "kulla_conty" else {}
     common = dict(Scale=scale_a, Bias=bias_b, Prefiltered=prefiltered, Irradiance=irradiance, **extra)
     m = surface["Metallic"]
-    spec = op.scale(spec_fn(F0=surface["Dielectric F0"], **common)["Specular"], 1.0 - m) \
-        + op.scale(spec_fn(F0=surface["Metal F0"], **common)["Specular"], m)
+    spec = op.scale(spec_fn(tables, F0=surface["Dielectric F0"], **common)["Specular"], 1.0 - m) \
+        + op.scale(spec_fn(tables, F0=surface["Metal F0"], **common)["Specular"], m)
 
     if features.cloth:
-        lobe = SH_LTC_CLOTH(N=n, V=v, Roughness=r)
+        lobe = SH_LTC_CLOTH(tables, N=n, V=v, Roughness=r)
         cloth = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
         w = surface["Cloth Weight"]
         spec = op.scale(spec, 1.0 - w) + op.scale(op.vmul(surface["Cloth Color"], cloth), w)
     total = spec + op.vmul(surface["Albedo"], diffuse)
     if features.sheen:
-        lobe = SH_LTC_SHEEN(N=n, V=v)
+        lobe = SH_LTC_SHEEN(tables, N=n, V=v)
         sheen = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
         total = total + op.vmul(surface["Sheen Color"], sheen)
     return op.scale(total, params["Strength"])
@@ -369,15 +373,23 @@ def world_radiance(features, env, surface, params):
 @functools.lru_cache(maxsize=16)
 def shade_world_function(features, env):
     """``RTL Shade World (<features>)``: the environment's radiance towards the viewer."""
-    from .rt_lit import SURFACE_OUTPUTS
 
-    def shade(**kw):
+    def shade(tables, **kw):
         surface = {k: kw[k] for k in WORLD_SURFACE}
-        params = {k: kw[f"World {k}"] for k in WORLD_PARAMETERS}
-        return {"Radiance": world_radiance(features, env, surface, params)}
+        params = {k: kw[world_input(k)] for k in WORLD_PARAMETERS}
+        return {"Radiance": world_radiance(tables, features, env, surface, params)}
 
     inputs = {k: SURFACE_OUTPUTS[k] for k in WORLD_SURFACE}
-    inputs.update({f"World {k}": s for k, s in WORLD_PARAMETERS.items()})
+    inputs.update({world_input(k): s for k, s in WORLD_PARAMETERS.items()})
     return NodeFunction(f"RTL Shade World ({features.label()}; {env.name})", shade, inputs,
                         {"Radiance": color((0.0, 0.0, 0.0), "Radiance towards the viewer from the world")},
-                        f"The world's image-based lighting on the RT Lit material ({features.label()})")
+                        f"The world's image-based lighting on the RT Lit material ({features.label()})",
+                        tables=REFERENCES)
+
+
+def shade_world(tables, features, env, surface, params):
+    """The world term: ``surface`` the "RTL Surface" outputs, ``params`` the ``WORLD_PARAMETERS``;
+    arrays (``tables`` with data, the environment's table included) or Exprs."""
+    args = {k: surface[k] for k in WORLD_SURFACE}
+    args.update({world_input(k): params[k] for k in WORLD_PARAMETERS})
+    return shade_world_function(features, env)(tables, **args)["Radiance"]

@@ -37,12 +37,13 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
-import _bootstrap  # noqa: F401
 
-from rt_lookdev.core.materials.rt_lit_interface import Features
+from ..core.materials.rt_lit_interface import Features
+from .suite_cases import Variant
 
 CELL = 2.2                          # world units per sphere cell (validation_suite.CELL)
 BLOCK_GAP = 60.0                    # the truth block sits this far below the node block (Z)
@@ -71,20 +72,16 @@ MULTISCATTER = ("turquin", "fdez_aguera", "fdez_aguera_radiance", "kulla_conty")
 def technique_material(technique, roughness):
     """RT Lit input values (validation_suite.technique_material): white Lambert / CoD (specular off by
     a black cloth of weight 1), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
-    import validation_suite as suite
+    from . import suite_cases as suite
 
     base = technique if technique in ("lambert", "cod") else "ggx"
     return suite.technique_material(base, roughness)
 
 
 @dataclass(frozen=True)
-class WorldVariant:
-    technique: str
-    roughness: float = 0.5
-
-    @property
-    def features(self):
-        return TECHNIQUES[self.technique][0]
+class WorldVariant(Variant):
+    """A sphere under the world: ``techniques`` are the world's (features, Cycles closure, text)."""
+    techniques: ClassVar[dict] = TECHNIQUES
 
     @property
     def closure(self):
@@ -204,13 +201,9 @@ class Block:
 
 def write_constant_equirect(path, value=1.0, width=64, height=32):
     """A constant equirect EXR (the uniform furnace world as an Environment Texture)."""
-    import OpenEXR
+    from . import exr_images
 
-    rgb = np.full((height, width, 3), float(value), np.float32)
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-    with OpenEXR.File(header, {"RGB": rgb}) as f:
-        f.write(str(path))
-    return Path(path)
+    return exr_images.write_rgb(path, np.full((height, width, 3), float(value), np.float32))
 
 
 def setup_world(scene, spec):
@@ -261,7 +254,7 @@ def _sphere(mesh, name, location, material):
 def closure_material(closure, name):
     """Cycles closure material of a truth sphere: ("DIFFUSE", 0) white Diffuse BSDF (roughness 0 =
     Lambert), ("GGX" | "MULTI_GGX", r) white Glossy BSDF (F = 1)."""
-    import validation_suite as suite
+    from . import suite_cases as suite
 
     kind, r = closure
     technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin"}[kind]
@@ -286,7 +279,7 @@ def new_scene():
 def sphere_mesh(segments=192, rings=96):
     import bpy
 
-    import validate_energy
+    from . import energy_render as validate_energy
 
     existing = bpy.data.meshes.get("RTL_valw_sphere")
     return existing or validate_energy._uv_sphere_mesh(bpy, "RTL_valw_sphere", segments, rings)
@@ -296,7 +289,7 @@ def add_node_block(scene, variants, cell_px, columns, z0=0.0, lut_dir=None, mesh
     """RT Lit spheres (one per variant) in a grid centred at (0, 0, z0)."""
     import bpy
 
-    from rt_lookdev.addon import materials
+    from ..addon import materials
 
     mesh = mesh or sphere_mesh()
     objects = []
@@ -348,7 +341,7 @@ def block_index(block, normal):
 
 def render_node(scene, block, blocks, folder):
     """(a): the RT Lit block rendered, 1 sample at pixel centres, with passes."""
-    from engine_parity import render_cycles_passes
+    from .engines import render_cycles_passes
 
     res = frame(scene, block, blocks)
     return render_cycles_passes(scene, res, path=folder)
@@ -357,9 +350,9 @@ def render_node(scene, block, blocks, folder):
 def render_truth(scene, block, blocks, samples, seeds, folder, threads=2):
     """(c): the closure block rendered with Cycles path tracing, direct light only, once per seed.
     Returns ([rgb per seed], [seconds per seed], normal)."""
-    import validate_energy
+    from . import energy_render as validate_energy
 
-    import validation_suite as suite
+    from . import suite_cases as suite
 
     frame(scene, block, blocks)
     images, seconds, normal = [], [], None
@@ -375,75 +368,10 @@ def render_truth(scene, block, blocks, samples, seeds, folder, threads=2):
 
 # --- (b) numpy ----------------------------------------------------------------------------------------
 
-def numpy_material(variant):
-    """RT_LIT_INPUTS name -> numpy value of a variant (validation_suite._numpy_material)."""
-    from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS
-
-    out = {}
-    m = variant.material()
-    for name, sock in RT_LIT_INPUTS.items():
-        v = m.get(name, sock.default)
-        if sock.kind == "float":
-            out[name] = float(v)
-        elif name == "Normal":
-            out[name] = np.zeros(3)
-        else:
-            out[name] = np.array(list(v)[:3], dtype=np.float64)
-    return out
-
-
 def world_params_numpy(params):
     """world_parameters(scene) values as numpy (tuples -> arrays)."""
     return {k: (np.asarray(v, np.float64) if isinstance(v, (tuple, list, np.ndarray)) else float(v))
             for k, v in params.items()}
-
-
-def numpy_radiance(block, variants, scene, passes, index, world, dtype=np.float32):
-    """(b): each sphere's RT Lit IR (lights of the scene: none; ``world`` = (WorldEnvironment, params))
-    evaluated by the numpy backend at the render's Position / Normal passes, float32 with Cycles' node
-    semantics (float64 on request)."""
-    from engine_parity import camera_incoming
-    from rt_lookdev.addon import materials
-    from rt_lookdev.core.ir import Graph
-    from rt_lookdev.core.ir.numpy_backend import evaluate
-    from rt_lookdev.core.materials import rt_lit
-
-    import validation_suite as suite
-
-    pos = passes["Position"].astype(np.float64)
-    nrm = passes["Normal"].astype(np.float64)
-    out = np.zeros(pos.shape)
-    lights = suite.scene_light_params(scene)
-    env, params = world
-    params = world_params_numpy(params)
-    for i, variant in enumerate(variants):
-        mine = index == i
-        if not mine.any():
-            continue
-        mat = block.objects[i].data.materials[0]
-        mparams = {k: (np.array(v) if isinstance(v, tuple) else v)
-                   for k, v in materials.material_parameters(mat).items()}
-        geo = {"Position": pos[mine], "Geometry Normal": nrm[mine], "Incoming": camera_incoming(scene, pos[mine])}
-        g = Graph()
-        traced = rt_lit.rt_lit_radiance(variant.features, mparams, {k: g.input(k, "vector") for k in geo}, lights,
-                                        world=(env, params))
-        out[mine] = evaluate(traced, geo, dtype)
-    return out
-
-
-def conditioning(fn, passes):
-    """Per value: how far float32 rounding moves (b) (validate.py's definition): the float64 evaluation
-    moved by one float32 ulp of position and normal (random signs), and float32 vs float64 at both."""
-    b = fn(passes, np.float32)
-    b64 = fn(passes, np.float64)
-    moved = dict(passes)
-    signs = np.random.default_rng(17)
-    for key in ("Position", "Normal"):
-        x = passes[key].astype(np.float32)
-        moved[key] = np.nextafter(x, np.where(signs.random(x.shape) < 0.5, -np.inf, np.inf).astype(np.float32))
-    b64_moved = fn(moved, np.float64)
-    b32_moved = fn(moved, np.float32)
-    return b, np.maximum.reduce([np.abs(b - b64), np.abs(b64_moved - b64), np.abs(b32_moved - b64_moved)])
 
 
 # --- brute-force references --------------------------------------------------------------------------
@@ -451,7 +379,7 @@ def conditioning(fn, passes):
 def image_quadrature(image, size=(128, 64)):
     """Texel directions (T, 3) (image frame), solid-angle weights (T,) and radiance (T, 3) of an equirect
     image area-averaged (equirect.downsample, solid-angle weighted) to ``size`` = (W, H)."""
-    from rt_lookdev.core.environment import equirect
+    from ..core.environment import equirect
 
     image = np.asarray(image, np.float32)
     w, h = size
@@ -478,8 +406,8 @@ def lambert_reference_image(quad, n, chunk=512):
 def cod_reference_image(quad, n, v, roughness, chunk=64):
     """Brute force of the true CoD WWII BRDF (albedo 1) over the image's texels:
     int L(l) f_CoD(l, v) (n.l) dl, n and v (K, 3) unit in the image frame, roughness (K,) -> (K, 3)."""
-    from rt_lookdev.core.conventions import ALPHA_MIN
-    from rt_lookdev.core.diffuse import cod_multiscatter_diffuse
+    from ..core.conventions import ALPHA_MIN
+    from ..core.diffuse import cod_multiscatter_diffuse
 
     dirs, wts, rad = quad
     n = np.asarray(n, np.float64)
@@ -506,8 +434,8 @@ def sync_world(scene, cache_dir, lut_dir=None):
     """Bake (cached in ``cache_dir``) and sync the scene's world for RT Lit (``addon.world``): returns
     (WorldEnvironment, world_parameters(scene), EnvironmentBake, the image array Cycles renders
     (``world_image_array``: scene linear, top row first))."""
-    from rt_lookdev.addon import materials
-    from rt_lookdev.addon import world as addon_world
+    from ..addon import materials
+    from ..addon import world_sync as addon_world
 
     setup = addon_world.world_setup(scene.world)
     if not setup.usable:
@@ -517,7 +445,7 @@ def sync_world(scene, cache_dir, lut_dir=None):
     if record is None:
         raise RuntimeError("sync_world built no 'RTL World' group")
     materials.rebuild_rt_lit_groups(scene, lut_dir)
-    found = materials.world_environment()
+    found = addon_world.world_environment()
     if found is None:
         raise RuntimeError("no 'RTL World' group with a bake record after sync_world")
     return found[0], addon_world.world_parameters(scene), bake, addon_world.world_image_array(setup.image)
@@ -527,7 +455,7 @@ def measure_bake(scene, cache_dir):
     """Bake time of the scene's world as RT Lookdev > Sync World bakes it (``addon.world.bake_world``:
     the image's pixels through ``core.environment.prefilter.bake_environment_image``), forced, then a
     cached re-run: {"forced" | "cached": {"states", "seconds" (the bake's own), "wall" (the call)}}."""
-    from rt_lookdev.addon import world as addon_world
+    from ..addon import world_sync as addon_world
 
     out = {}
     for key, force in (("forced", True), ("cached", False)):
@@ -580,8 +508,8 @@ def ggx_reference_image(quad, n, v, roughness, chunk=16):
     """Brute force of the single-scattering GGX BRDF (F = 1, height-correlated Smith: Cycles' Glossy GGX)
     over the image's texels: int L(l) f_ss(l, v) (n.l) dl, n and v (K, 3) unit in the image frame.
     Point-sampling texel centres: meaningful where the lobe spans several texels (alpha >~ 4 x texel)."""
-    from rt_lookdev.core.conventions import ALPHA_MIN
-    from rt_lookdev.core.microfacet import ggx_brdf
+    from ..core.conventions import ALPHA_MIN
+    from ..core.microfacet import ggx_brdf
 
     dirs, wts, rad = quad
     alpha = max(float(roughness) ** 2, ALPHA_MIN)

@@ -2,7 +2,7 @@
 
 Reference data: Cycles' own GGX albedo table, ``table_ggx_E`` / ``table_ggx_Eavg`` of
 blender/cycles ``src/scene/shader.tables`` (unchanged v4.0 - v5.x), nodes copied from
-../shared/reference/multiscatter.md §1.2.  Axes there: r = sqrt(alpha) at i/31, mu at j/31.
+docs/multiscattering.md, "Cycles' GGX albedo table".  Axes there: r = sqrt(alpha) at i/31, mu at j/31.
 """
 from __future__ import annotations
 

@@ -12,7 +12,7 @@ Mesa llvmpipe).
 Meant for emission-only scenes (a plane in front of a camera, black world): EEVEE's film is half
 precision (relative error up to ~1e-3 from rounding alone, 2^-10), it writes 0 for negative
 emission and returns 0 for out-of-domain asin/acos where Cycles clamps the input
-(../shared/reference/blender_addon.md §2.5). With anisotropic filtering off, Linear image lookups
+(docs/blender.md, "EEVEE measurement"). With anisotropic filtering off, Linear image lookups
 match exact bilinear filtering to half precision on llvmpipe (with the default 2x they are off by up
 to 0.1 texel).
 
@@ -31,24 +31,20 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _bootstrap  # noqa: E402,F401
 
-from rt_lookdev.addon.render_setup import (configure_cycles_measurement, configure_eevee_measurement,
+from . import exr_images
+from .render_setup import (configure_cycles_measurement, configure_eevee_measurement,
                                            eevee_texture_filtering)
 
 ENGINES = ("CYCLES", "BLENDER_EEVEE")
 
 
-def _read_exr(path):
-    import OpenEXR
-
-    with OpenEXR.File(str(path), separate_channels=True) as f:
-        ch = {n: np.array(c.pixels) for p in f.parts for n, c in p.channels.items()}
-    return np.stack([ch["R"], ch["G"], ch["B"]], axis=-1).astype(np.float32)   # row 0 = top
+def read_exr_rgb(path):
+    """RGB of a rendered EXR as float32 (H, W, 3), row 0 = top."""
+    return exr_images.read_layer(path, "", "RGB")
 
 
-def _output_settings(scene, w, h, filepath):
+def output_settings(scene, w, h, filepath):
     r = scene.render
     r.resolution_x, r.resolution_y, r.resolution_percentage = int(w), int(h), 100
     r.use_border = False
@@ -98,12 +94,12 @@ def render_engines(scene, engines=ENGINES, resolution=(64, 64), path=None, sampl
         for engine in engines:
             exr = folder / f"{engine.lower()}.exr"
             configure_engine(scene, engine, samples=samples)
-            _output_settings(scene, w, h, exr)
+            output_settings(scene, w, h, exr)
             with eevee_texture_filtering() if engine == "BLENDER_EEVEE" else contextlib.nullcontext():
                 t0 = time.perf_counter()
                 bpy.ops.render.render(write_still=True, scene=scene.name)
                 seconds = time.perf_counter() - t0
-            out[engine] = (_read_exr(exr), seconds)
+            out[engine] = (read_exr_rgb(exr), seconds)
     finally:
         if tmp is not None:
             tmp.cleanup()
@@ -195,7 +191,6 @@ def render_cycles_passes(scene, resolution=(64, 64), path=None):
     """Cycles, 1 sample at pixel centres, emission only: {"Combined": (H, W, 3), "Position": ...,
     "Normal": ..., "seconds": s} (world space, row 0 = top; background pixels have Normal 0)."""
     import bpy
-    import OpenEXR
 
     w, h = (resolution, resolution) if np.isscalar(resolution) else resolution
     tmp = tempfile.TemporaryDirectory(prefix="rtl-passes-") if path is None else None
@@ -204,7 +199,7 @@ def render_cycles_passes(scene, resolution=(64, 64), path=None):
     exr = folder / "cycles_passes.exr"
     try:
         configure_engine(scene, "CYCLES")
-        _output_settings(scene, w, h, exr)
+        output_settings(scene, w, h, exr)
         vl = scene.view_layers[0]
         vl.use_pass_position = vl.use_pass_normal = True
         s = scene.render.image_settings
@@ -214,15 +209,10 @@ def render_cycles_passes(scene, resolution=(64, 64), path=None):
         t0 = time.perf_counter()
         bpy.ops.render.render(write_still=True, scene=scene.name)
         seconds = time.perf_counter() - t0
-        with OpenEXR.File(str(exr), separate_channels=True) as f:
-            ch = {n: np.array(c.pixels) for p in f.parts for n, c in p.channels.items()}
-        prefix = f"{vl.name}."
-
-        def get(name, comps):
-            return np.stack([ch[f"{prefix}{name}.{c}"] for c in comps], axis=-1).astype(np.float32)
-
-        return {"Combined": get("Combined", "RGB"), "Position": get("Position", "XYZ"),
-                "Normal": get("Normal", "XYZ"), "seconds": seconds}
+        ch = exr_images.read_channels(exr)
+        return {"Combined": exr_images.find_pass(ch, "Combined", "RGB"),
+                "Position": exr_images.find_pass(ch, "Position", "XYZ"),
+                "Normal": exr_images.find_pass(ch, "Normal", "XYZ"), "seconds": seconds}
     finally:
         if tmp is not None:
             tmp.cleanup()

@@ -24,15 +24,15 @@ def aim(obj, target=(0.0, 0.0, 0.0)):
     obj.rotation_quaternion = direction.to_track_quat("-Z", "Y")
 
 
-def build(features_by_material, kinds=None, resolution=48, hdri=None, world_strength=0.7):
+def build(features_by_material, kinds=None, resolution=48, hdri=None, world_strength=0.7, lut_dir=None):
     """Spheres side by side (one per (name, Features)) lit by the LIGHTS (``kinds`` filters them) and,
-    with ``hdri``, by that studio HDRI's World term."""
+    with ``hdri``, by that studio HDRI's World term; RT Lit groups read the LUTs of ``lut_dir``."""
     import bmesh
     import bpy
 
-    from build_demo_scene import add_hdri_world
-    from rt_lookdev.addon import materials
-    from rt_lookdev.addon import world as rtl_world
+    from ..addon import materials
+    from ..addon import world_sync as rtl_world
+    from ..addon.demo_scene import add_hdri_world
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
@@ -65,7 +65,7 @@ def build(features_by_material, kinds=None, resolution=48, hdri=None, world_stre
         for poly in mesh.polygons:
             poly.use_smooth = True
         mat = bpy.data.materials.new(name)
-        materials.assign_rt_lit(mat, features, scene)
+        materials.assign_rt_lit(mat, features, scene, lut_dir)
         mesh.materials.append(mat)
         obj = bpy.data.objects.new(name, mesh)
         obj.location = (2.2 * (i - 0.5 * (count - 1)), 0.0, 0.0)
@@ -82,23 +82,23 @@ def build(features_by_material, kinds=None, resolution=48, hdri=None, world_stre
     return scene
 
 
-def numpy_radiance(scene, passes):
-    """The RT Lit materials evaluated in numpy (float64) at the render's pixels, and the mask of
-    pixels that hit a sphere.  Each pixel's material is found by the sphere it lies on."""
-    import bpy
-
-    from rt_lookdev.addon import materials
-    from rt_lookdev.addon import world as rtl_world
-    from rt_lookdev.core.materials import rt_lit
-    from rt_lookdev.core.materials.rt_lit_interface import Features
-    from engine_parity import camera_incoming
+def numpy_radiance(scene, passes, tables):
+    """The RT Lit materials evaluated directly in numpy (float64, ``core.materials.rt_lit.rt_lit_radiance``
+    with the LUT set ``tables``) at the render's pixels, and the mask of pixels that hit a sphere.  Each
+    pixel's material is found by the sphere it lies on."""
+    from ..addon import materials
+    from ..addon import world_sync as rtl_world
+    from ..addon.common import FEATURES_KEY
+    from ..core.materials import rt_lit
+    from ..core.materials.rt_lit_interface import Features
+    from .engines import camera_incoming
 
     pos = passes["Position"].astype(np.float64)
     nrm = passes["Normal"].astype(np.float64)
     hit = np.linalg.norm(nrm, axis=-1) > 0.5
     out = np.zeros(pos.shape)
     lights = [(kind, materials.light_parameters(obj, kind)) for obj, kind in materials.scene_lights(scene)]
-    env = materials.world_environment()
+    env = rtl_world.world_environment()
     world = None if env is None else (env[0], rtl_world.world_parameters(scene))
     for obj in scene.objects:
         if obj.type != "MESH":
@@ -107,9 +107,9 @@ def numpy_radiance(scene, passes):
         if not mine.any():
             continue
         mat = obj.data.materials[0]
-        features = Features.from_dict(mat[materials.FEATURES_KEY])
+        features = Features.from_dict(mat[FEATURES_KEY])
         params = {k: (np.array(v) if isinstance(v, tuple) else v)
                   for k, v in materials.material_parameters(mat).items()}
         geo = {"Position": pos[mine], "Geometry Normal": nrm[mine], "Incoming": camera_incoming(scene, pos[mine])}
-        out[mine] = rt_lit.rt_lit_radiance(features, params, geo, lights, world)
+        out[mine] = rt_lit.rt_lit_radiance(tables, features, params, geo, lights, world)
     return out, hit

@@ -28,6 +28,7 @@ Measured with bpy 5.0.1 (small Cycles renders; tests/blender/test_world_setup.py
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 import re
 from dataclasses import dataclass
@@ -38,23 +39,20 @@ import numpy as np
 
 from ..core.environment import equirect, prefilter
 from ..core.ir.expr import FLOAT, VECTOR
-from ..core.ir.interface import Socket
-from . import node_emit
+from ..core.materials.rt_lit_interface import world_input
+from ..core.materials.world_shading import SH_NAMES, WORLD_PARAMETERS, WorldEnvironment
+from .common import (IMAGE_PREFIX, NODE_GROUP_PREFIX, WORLD_GROUP, WORLD_RECORD_KEY, add_driver, ensure_interface,
+                     remove_drivers, socket_by_identifier)
 
-WORLD_GROUP = "RTL World"
-RECORD_KEY = "rtl_world"
+RECORD_KEY = WORLD_RECORD_KEY
 CACHE_ENV = "RTL_ENVIRONMENT_CACHE"
-SH_COUNT = 9
+SH_COUNT = len(SH_NAMES)
 
-#: Output sockets of "RTL World", in order: (name, kind, spec).
-WORLD_OUTPUTS = (
-    *((f"World SH {i}", VECTOR, Socket("vector", (0.0, 0.0, 0.0), description=(
-        f"L2 SH radiance coefficient {i} (R&H 2001 order) of the world image, RGB, image frame, strength 1 "
-        "(baked by RT Lookdev > Sync World)"))) for i in range(SH_COUNT)),
-    ("World Strength", FLOAT, Socket("float", 1.0, description="The World's Background Strength (driver)")),
-    ("World Rotation", VECTOR, Socket("vector", (0.0, 0.0, 0.0), subtype="EULER", description=(
-        "Euler XYZ rotation (radians) of the World's Mapping node (driver; 0 without a Mapping node)"))),
-)
+#: Output sockets of "RTL World", in order: (name, kind, spec): the RT Lit material's world inputs, as
+#: Vector sockets (the SH coefficients are RGB triples fed to vector inputs, converted exactly).
+WORLD_OUTPUTS = tuple((world_input(name), FLOAT, sock) if sock.kind == "float" else
+                      (world_input(name), VECTOR, dataclasses.replace(sock, kind="vector", default=(0.0, 0.0, 0.0)))
+                      for name, sock in WORLD_PARAMETERS.items())
 
 _MAPPING_TYPES = ("POINT", "VECTOR")
 _IMAGE_SOURCES = ("FILE", "GENERATED")
@@ -314,19 +312,8 @@ def _input_path(node, socket):
 
 
 def _drive(socket, world, data_path):
-    """A simple-expression driver ``var`` on socket.default_value reading ``world``'s ``data_path``."""
-    fc = socket.driver_add("default_value")
-    drv = fc.driver
-    drv.type = "SCRIPTED"
-    drv.expression = "var"
-    var = drv.variables.new()
-    var.name = "var"
-    var.type = "SINGLE_PROP"
-    target = var.targets[0]
-    target.id_type = "WORLD"
-    target.id = world
-    target.data_path = data_path
-    return fc
+    """A simple-expression driver on socket.default_value reading ``world``'s ``data_path``."""
+    return add_driver(socket, world, ("data", data_path), "WORLD")
 
 
 def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
@@ -346,18 +333,16 @@ def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
     ng = bpy.data.node_groups.get(WORLD_GROUP)
     if ng is None or ng.bl_idname != "ShaderNodeTree":
         ng = bpy.data.node_groups.new(WORLD_GROUP, "ShaderNodeTree")
-    if ng.animation_data is not None:
-        for fc in list(ng.animation_data.drivers):
-            ng.animation_data.drivers.remove(fc)
+    remove_drivers(ng)
     ng.nodes.clear()
     ng.description = ("The World's environment for RT Lit: baked SH coefficients and driven strength and rotation "
                       "(rebuilt by RT Lookdev > Sync World)")
-    items = node_emit._ensure_interface(ng, [(name, "OUTPUT", kind, spec) for name, kind, spec in WORLD_OUTPUTS])
+    items = ensure_interface(ng, [(name, "OUTPUT", kind, spec) for name, kind, spec in WORLD_OUTPUTS])
     out = ng.nodes.new("NodeGroupOutput")
     out.location = (400.0, 0.0)
 
     def output(name):
-        return node_emit._socket(out.inputs, items[(name, "OUTPUT")].identifier)
+        return socket_by_identifier(out.inputs, items[(name, "OUTPUT")].identifier)
 
     def combine(name, values, row):
         node = ng.nodes.new("ShaderNodeCombineXYZ")
@@ -365,11 +350,11 @@ def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
         node.location = (0.0, -row * 140.0)
         for sock, value in zip(node.inputs, values):
             sock.default_value = float(value)
-        ng.links.new(node.outputs[0], output(f"World {name}"))
+        ng.links.new(node.outputs[0], output(world_input(name)))
         return node
 
-    for i in range(SH_COUNT):
-        combine(f"SH {i}", bake.sh_image[i], i)
+    for i, name in enumerate(SH_NAMES):
+        combine(name, bake.sh_image[i], i)
 
     background = setup.background
     strength_socket = background.inputs["Strength"]
@@ -378,7 +363,7 @@ def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
     value.location = (0.0, -SH_COUNT * 140.0)
     value.outputs[0].default_value = float(strength_socket.default_value)
     _drive(value.outputs[0], world, _input_path(background, strength_socket))
-    ng.links.new(value.outputs[0], output("World Strength"))
+    ng.links.new(value.outputs[0], output(world_input("Strength")))
 
     mapping = setup.mapping
     rotation = combine("Rotation", _rotation(setup), SH_COUNT + 1)
@@ -391,8 +376,38 @@ def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
               "sh": str(bake.sh_path), "source_hash": bake.source_hash, "image": setup.image.name,
               "roughness_levels": _roughness_levels(bake)}
     ng[RECORD_KEY] = record
-    node_emit.register_image(record["table"], bake.prefiltered_path)
     return record
+
+
+def world_environment():
+    """(WorldEnvironment, record) of the synced world, or None when "RTL World" is absent.  The
+    environment is read from the bake's cache file, or from the image packed in this .blend when the
+    cache is gone (another machine, a cleaned cache)."""
+    ng = bpy.data.node_groups.get(WORLD_GROUP)
+    record = ng[RECORD_KEY].to_dict() if ng is not None and RECORD_KEY in ng.keys() else None
+    if not record:
+        return None
+    try:
+        env = WorldEnvironment.load(record["prefiltered"], record["table"])
+    except Exception as exc:
+        env = _packed_environment(record)
+        if env is None:
+            raise RuntimeError(f"the baked world environment {record['prefiltered']} cannot be read ({exc}) and "
+                               "is not packed in this file; run RT Lookdev > Sync RT Lit World again") from exc
+    return env, record
+
+
+def _packed_environment(record):
+    image = bpy.data.images.get(IMAGE_PREFIX + record["table"])
+    levels = record.get("roughness_levels")
+    if image is None or not levels:
+        return None
+    w, h = image.size
+    if w * h == 0 or len(image.pixels) != w * h * 4:
+        return None
+    table = np.empty(w * h * 4, np.float32)
+    image.pixels.foreach_get(table)               # bottom row first: the table's row order
+    return WorldEnvironment(record["table"], table.reshape(h, w, 4), tuple(float(r) for r in levels))
 
 
 def remove_stale_environment_images(keep=None):
@@ -408,12 +423,12 @@ def remove_stale_environment_images(keep=None):
         changed = False
         for ng in list(bpy.data.node_groups):
             name = ng.name
-            if name.startswith("RTL ") and "env_" in name and not (keep and keep in name) and ng.users == 0:
+            if name.startswith(NODE_GROUP_PREFIX) and "env_" in name and not (keep and keep in name) and ng.users == 0:
                 removed.append(name)
                 bpy.data.node_groups.remove(ng)
                 changed = True
     for image in list(bpy.data.images):
-        if not image.name.startswith("RTL_env_") or image.name == f"RTL_{keep}":
+        if not image.name.startswith(IMAGE_PREFIX + "env_") or image.name == IMAGE_PREFIX + str(keep):
             continue
         if image.users - int(image.use_fake_user) == 0:
             removed.append(image.name)
@@ -447,11 +462,11 @@ def world_parameters(scene, cache_dir=None, settings=None):
     if not setup.usable:
         return None
     ng = bpy.data.node_groups.get(WORLD_GROUP)
-    if ng is not None and all(f"SH {i}" in ng.nodes for i in range(SH_COUNT)):
-        sh = np.array([[float(s.default_value) for s in ng.nodes[f"SH {i}"].inputs[:3]] for i in range(SH_COUNT)])
+    if ng is not None and all(name in ng.nodes for name in SH_NAMES):
+        sh = np.array([[float(s.default_value) for s in ng.nodes[name].inputs[:3]] for name in SH_NAMES])
     else:
         sh = bake_world(scene, cache_dir, settings=settings).sh_image
-    params = {f"SH {i}": np.asarray(sh[i], dtype=np.float64) for i in range(SH_COUNT)}
+    params = {name: np.asarray(sh[i], dtype=np.float64) for i, name in enumerate(SH_NAMES)}
     params["Strength"] = float(setup.background.inputs["Strength"].default_value)
     params["Rotation"] = np.array(_rotation(setup), dtype=np.float64)
     return params
@@ -467,4 +482,4 @@ def bake_summary(bake):
 
 
 __all__ = ["WORLD_GROUP", "WorldSetup", "world_setup", "world_image_array", "default_cache_dir", "bake_world",
-           "sync_world", "world_parameters", "remove_world_group", "bake_summary"]
+           "sync_world", "world_environment", "world_parameters", "remove_world_group", "bake_summary"]

@@ -1,4 +1,4 @@
-"""Bake the lookup tables into EXR files, skipping groups whose files are already current.
+"""Bake the lookup tables (``core.lut.catalog``) into EXR files, skipping groups whose files are already current.
 
 A group is current when every one of its files reads back intact (content hash) and was
 baked from the same inputs (``catalog.inputs_hash``: layout version, parameters and the
@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import energy
-from . import catalog, exr_io
+from . import energy
+from .lut import catalog, exr_io
 
-GENERATOR = "rt_lookdev.core.lut.bake"
+GENERATOR = "rt_lookdev.core.lut_bake"
 
 
 @dataclass(frozen=True)
@@ -55,7 +55,7 @@ def compute_energy_tables(size, n_samples, progress=None):
 
 def compute_ltc_tables(prefix, params, progress=None):
     """The two LTC tables of one lobe (core/ltc/fit.py), sphere table in the spare channel."""
-    from ..ltc import fit, sphere_table
+    from .ltc import fit, sphere_table
 
     n_lobe, n_ltc, n_sphere = params["fit_samples"]
     result = fit.fit_table(params["lobe"], size=params["size"], n_moments=params["moment_samples"],

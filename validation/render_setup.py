@@ -5,7 +5,7 @@ A measurement render must be linear, unclamped, reproducible and point-sampled:
 - pixel filter Gaussian at its minimum width 0.01, so each sample is taken at the pixel centre.
   Not Box: Cycles' Box filter ignores ``filter_width`` and spreads samples over the whole pixel
   (measured: 320 partly covered silhouette pixels on a 96 px sphere with Box at 0.01, 9 with
-  Gaussian; ../shared/reference/blender_addon.md §5, scripts/validate_energy.py);
+  Gaussian; docs/blender.md, "Render passes"; scripts/validate_energy.py);
 - view transform Standard, look None, exposure 0, gamma 1 (the EXR holds scene-linear values);
 - a fixed number of threads.
 
@@ -46,7 +46,7 @@ def configure_eevee_measurement(scene, samples=1, filter_size=0.0, black_world=T
 
     EEVEE (Blender 4.2+/5.0, "EEVEE Next") cannot match Cycles bit for bit: its film is half
     precision (relative error up to 2^-10) and it writes 0 where the emission is negative
-    (../shared/reference/blender_addon.md §2.5). These settings remove every other source of
+    (docs/blender.md, "EEVEE measurement"). These settings remove every other source of
     difference found on Mesa llvmpipe (EGL):
     - ``taa_render_samples`` = ``samples`` (1: a single sample, no temporal accumulation);
     - film filter ``filter_size`` 0 (default 1.5 px; the RNA minimum; EEVEE has no filter type).

@@ -1,0 +1,104 @@
+"""One scene light on the RT Lit material: its lobes combined with the material's colours.
+
+``shade_function(kind, features)`` is the node function "RTL Shade <Kind> (<features>)": the lobes
+of the enabled techniques (``lobes``) for that light kind, weighted by the surface's colours
+(``surface``), times the light's radiance (area lights) or irradiance (punctual lights;
+core/lights.py).  Colours are 3-vectors; the specular colour is F0 * Scale + Bias per channel.
+"""
+from __future__ import annotations
+
+import functools
+
+from .. import lights, multiscatter
+from .. import shading_ops as op
+from ..fresnel import fresnel_average
+from ..ir.functions import NodeFunction
+from ..ir.interface import color
+from ..lut.lookup import REFERENCES
+from . import lobes
+from .rt_lit_interface import GEOMETRY_INPUTS, SURFACE_OUTPUTS
+
+
+def combine_lobes(features, surface, lobe_values, light_color):
+    """Radiance towards the viewer from one light: the enabled lobes weighted by the material's
+    colours, times the light's colour (radiance or irradiance, per light kind)."""
+    f0 = surface["F0"]
+    spec = op.scale(f0, lobe_values["Scale"]) + op.splat(lobe_values["Bias"])
+    if features.specular == "turquin":
+        # Turquin 2019, eq. 16 (the talk): f_ss (1 + F0 (1 - E)/E)
+        spec = op.vmul(spec, op.per_channel(multiscatter.turquin_compensation, f0, lobe_values["E"]))
+    elif features.specular == "fdez_aguera":
+        # The talk's approximation to Fdez-Aguera 2019: f_ss (1 + F_avg (1 - E)/(1 - F_avg (1 - E)))
+        spec = op.vmul(spec, op.per_channel(multiscatter.fdez_aguera_area_scale, f0, lobe_values["E"]))
+    elif features.specular == "kulla_conty":
+        # Kulla & Conty 2017: + F_ms(F_avg) f_ms
+        om_avg = lobe_values["One Minus E Avg"]
+        f_ms = op.per_channel(lambda c: multiscatter.kulla_conty_fresnel_factor(fresnel_average(c), om_avg), f0)
+        spec = spec + op.scale(f_ms, lobe_values["Lobe"])
+    if features.cloth:
+        cloth = op.scale(surface["Cloth Color"], lobe_values["Cloth"])
+        w = surface["Cloth Weight"]
+        spec = op.scale(spec, 1.0 - w) + op.scale(cloth, w)
+    total = spec + op.scale(surface["Albedo"], lobe_values["Diffuse"])
+    if features.sheen:
+        total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
+    return op.vmul(light_color, total)
+
+
+def lobe_keys(features):
+    """The lobes ``features`` enables, in evaluation order."""
+    keys = ["ggx", features.diffuse]
+    if features.specular == "kulla_conty":
+        keys.append("kulla_conty")
+    if features.cloth:
+        keys.append("cloth")
+    if features.sheen:
+        keys.append("sheen")
+    return keys
+
+
+#: The surface terms a light's shading reads.
+SHADE_SURFACE = ("N", "V", "Roughness", "F0", "Albedo", "Wrap", "Sheen Color", "Cloth Weight", "Cloth Color")
+
+
+def light_color_name(kind):
+    """"Radiance" for area lights, "Irradiance" for punctual lights (the light data's colour output)."""
+    return "Radiance" if "Radiance" in lights.LIGHT_DATA[kind].output_sockets else "Irradiance"
+
+
+def _arguments(fn, available):
+    return {name: available[name] for name in fn.input_sockets}
+
+
+@functools.lru_cache(maxsize=None)
+def shade_function(kind, features):
+    """``RTL Shade <Kind> (<features>)``: one light's radiance towards the viewer."""
+    color_name = light_color_name(kind)
+    functions = [lobes.LOBES[key].function(kind) for key in lobe_keys(features)]
+
+    def shade(tables, **kw):
+        values = {}
+        for fn in functions:
+            values.update(fn(tables, **_arguments(fn, kw)))
+        return {"Radiance": combine_lobes(features, kw, values, kw[color_name])}
+
+    inputs = {k: SURFACE_OUTPUTS[k] for k in SHADE_SURFACE}
+    if kind in lobes.AREA_KINDS + ("point", "spot"):
+        inputs["Position"] = GEOMETRY_INPUTS["Position"]
+    inputs.update(lobes.light_geometry_sockets(kind))
+    inputs[color_name] = lights.LIGHT_DATA[kind].output_sockets[color_name]
+    # only the inputs some lobe or the combination reads
+    used = set(SHADE_SURFACE) | {color_name}.union(*(fn.input_sockets for fn in functions))
+    inputs = {k: v for k, v in inputs.items() if k in used}
+    title = kind.capitalize() if kind not in lobes.AREA_KINDS else f"{kind.capitalize()} Area"
+    return NodeFunction(f"RTL Shade {title} ({features.label()})", shade, inputs,
+                        {"Radiance": color((0.0, 0.0, 0.0), "Radiance towards the viewer from this light")},
+                        f"One {kind} light on the RT Lit material ({features.label()})", tables=REFERENCES)
+
+
+def shade_light(tables, kind, features, surface, position, light):
+    """Radiance from one light: ``surface`` the "RTL Surface" outputs, ``light`` the outputs of the
+    light's data function (``core.lights.LIGHT_DATA``); arrays (``tables`` with data) or Exprs."""
+    fn = shade_function(kind, features)
+    available = dict(surface, Position=position, **light)
+    return fn(tables, **_arguments(fn, available))["Radiance"]

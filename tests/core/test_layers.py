@@ -1,0 +1,159 @@
+"""The architecture's rules, read from the source (docs/architecture.md, "Layers"):
+
+- imports go downwards only: core/ir < shading_ops, conventions < core/lut < core techniques <
+  core/materials < node_groups < addon < validation (scripts/ and tests/ sit on top);
+- no module of core/ imports bpy (or any other Blender module);
+- no sys.path edits in scripts/ or tests/ (the package is installed in editable mode: pyproject.toml);
+- every file name is used once in the tree;
+- every file in scripts/ is a thin entry point.
+"""
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+PACKAGES = ("core", "node_groups", "addon", "validation")
+BLENDER_MODULES = ("bpy", "bmesh", "mathutils", "gpu", "addon_utils", "_bpy", "bl_ui", "bpy_extras")
+
+#: (layer name, rank, test): a module's layer is the first whose test matches its dotted name.
+LAYERS = (
+    ("core.ir", 0, lambda m: m == "core.ir" or m.startswith("core.ir.")),
+    ("core ops", 1, lambda m: m in ("core.shading_ops", "core.conventions")),
+    ("core.lut", 2, lambda m: m == "core.lut" or m.startswith("core.lut.")),
+    ("core.materials", 4, lambda m: m == "core.materials" or m.startswith("core.materials.")),
+    ("core techniques", 3, lambda m: m == "core" or m.startswith("core.")),
+    ("node_groups", 5, lambda m: m.split(".")[0] == "node_groups"),
+    ("addon", 6, lambda m: m.split(".")[0] == "addon"),
+    ("validation", 7, lambda m: m.split(".")[0] == "validation"),
+)
+
+
+def layer_of(module):
+    for name, rank, test in LAYERS:
+        if test(module):
+            return name, rank
+    raise ValueError(f"{module} is in no layer")
+
+
+def _module_name(path):
+    parts = list(path.relative_to(REPO).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def project_modules():
+    return [p for pkg in PACKAGES for p in sorted((REPO / pkg).rglob("*.py"))]
+
+
+def imports_of(path, source=None):
+    """(project modules imported, other top-level modules imported) by one file (its ``source``, or
+    the file's text)."""
+    tree = ast.parse(path.read_text() if source is None else source, str(path))
+    name = _module_name(path)
+    package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+    project, external = set(), set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level:
+            base = package[:len(package) - node.level + 1]
+            target = ".".join(base + ([node.module] if node.module else []))
+            if node.module is None:
+                project.update(f"{target}.{a.name}" if target else a.name for a in node.names)
+            else:
+                project.add(target)
+        elif isinstance(node, ast.ImportFrom):
+            (project if node.module.split(".")[0] == "rt_lookdev" else external).add(node.module)
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                (project if alias.name.split(".")[0] == "rt_lookdev" else external).add(alias.name)
+    project = {m.removeprefix("rt_lookdev.") for m in project if m not in ("rt_lookdev", "")}
+    return project, {m.split(".")[0] for m in external}
+
+
+def _is_module(name):
+    base = REPO.joinpath(*name.split("."))
+    return base.with_suffix(".py").is_file() or (base / "__init__.py").is_file()
+
+
+def upward_imports(path, source=None):
+    """The imports of one file that climb a layer."""
+    me = _module_name(path)
+    my_layer, my_rank = layer_of(me)
+    found = []
+    for target in imports_of(path, source)[0]:
+        target = target if _is_module(target) else target.rsplit(".", 1)[0]   # "from .x import name"
+        layer, rank = layer_of(target)
+        if rank > my_rank:
+            found.append(f"{me} ({my_layer}) imports {target} ({layer})")
+    return found
+
+
+def test_imports_go_downwards_only():
+    upward = [line for path in project_modules() for line in upward_imports(path)]
+    assert not upward, "imports that climb a layer:\n  " + "\n  ".join(sorted(upward))
+
+
+@pytest.mark.parametrize("where,line", [
+    ("core/ir/semantics.py", "from ..materials import rt_lit"),
+    ("core/ir/expr.py", "from ..lut import lookup"),
+    ("core/lut/lookup.py", "from .. import multiscatter"),
+    ("core/materials/surface.py", "from ...addon import materials"),
+    ("addon/materials.py", "from ..validation import suite"),
+])
+def test_the_layer_rule_catches_an_upward_import(where, line):
+    """The rule fails on a lower layer importing a higher one (the same files with one import added)."""
+    path = REPO / where
+    assert not upward_imports(path)
+    assert upward_imports(path, path.read_text() + "\n" + line + "\n")
+
+
+def test_core_imports_no_blender_module():
+    offenders = []
+    for path in sorted((REPO / "core").rglob("*.py")):
+        _, external = imports_of(path)
+        bad = external & set(BLENDER_MODULES)
+        if bad:
+            offenders.append(f"{path.relative_to(REPO)}: {sorted(bad)}")
+    assert not offenders, offenders
+
+
+_SYS_PATH = re.compile(r"\bsys\.path(\.(insert|append|extend)\b|\s*(\[|\+?=))")
+
+
+@pytest.mark.parametrize("folder", ["scripts", "tests"])
+def test_no_sys_path_edits(folder):
+    offenders = [str(p.relative_to(REPO)) for p in sorted((REPO / folder).rglob("*.py"))
+                 if _SYS_PATH.search(p.read_text())]
+    assert not offenders, f"sys.path used in {offenders}; import rt_lookdev (editable install) instead"
+
+
+def test_file_names_are_unique():
+    seen = {}
+    for pkg in PACKAGES + ("scripts", "tests"):
+        for path in (REPO / pkg).rglob("*.py"):
+            if path.name in ("__init__.py", "conftest.py"):
+                continue
+            seen.setdefault(path.name, []).append(str(path.relative_to(REPO)))
+    twice = {name: paths for name, paths in seen.items() if len(paths) > 1}
+    assert not twice, twice
+
+
+def test_scripts_are_thin_entry_points():
+    """Entry points only: argument parsing, a call into the package, an exit code (<= 150 lines, no
+    function definitions beyond main and its small helpers)."""
+    for path in sorted((REPO / "scripts").glob("*.py")):
+        text = path.read_text()
+        lines = len(text.splitlines())
+        assert lines <= 150, f"{path.name}: {lines} lines"
+        assert 'if __name__ == "__main__":' in text, path.name
+        functions = [n.name for n in ast.walk(ast.parse(text)) if isinstance(n, ast.FunctionDef)]
+        assert len(functions) <= 4, (path.name, functions)
+
+
+def test_the_sys_path_rule_catches_edits():
+    edits = (".insert(0, here)", "[:0] = [a]", ".append(x)", " += [x]")       # (joined here, so that this
+    for tail in edits:                                                          # file passes its own rule)
+        assert _SYS_PATH.search("sys.path" + tail), tail
+    assert not _SYS_PATH.search("no sys.path edits in scripts/")

@@ -1,0 +1,117 @@
+"""Input grids of the conformance checks, shared by the tests of every backend (numpy, node groups).
+
+No bpy here: ``TECHNIQUES`` with ``technique_inputs`` (every technique's function and its argument grid,
+with zeros, 1e-7 and the domain's edges), ``punctual_lobe_inputs`` and ``area_lobe_inputs`` (the lobes'
+per-texel inputs: edge cases, grazing and below-horizon views, lights below, in the plane of, or tiny).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter
+from ..core.conventions import alpha_from_roughness
+
+#: Side of the square per-texel grids (one render pixel per texel).
+SIZE = 48
+
+
+def unit_vectors(rng, shape, special=()):
+    v = rng.normal(size=shape + (3,))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    flat = v.reshape(-1, 3)
+    for i, s in enumerate(special):
+        flat[i] = s
+    return v.astype(np.float32)
+
+
+def _ggx(mu_l, mu_v, n_dot_h, v_dot_h, r, f0):
+    return microfacet.ggx_brdf(mu_l, mu_v, n_dot_h, v_dot_h, alpha_from_roughness(r), f0)
+
+
+#: Every shading technique as (function, argument names): the IR evaluated by the numpy backend must equal
+#: the direct numpy evaluation (tests/core/test_ir.py), and the node group the numpy backend
+#: (tests/blender/test_node_conformance.py).
+TECHNIQUES = {
+    "ggx_brdf": (_ggx, ["mu_l", "mu_v", "n_dot_h", "v_dot_h", "r", "f0"]),
+    "fresnel_average": (lambda f0: fresnel.fresnel_average(f0), ["f0"]),
+    "kulla_conty_brdf": (multiscatter.kulla_conty_brdf, ["one_minus_e_o", "one_minus_e_i", "one_minus_e_avg", "f0"]),
+    "turquin": (multiscatter.turquin_compensation, ["f0", "e_v"]),
+    "fdez_aguera": (multiscatter.fdez_aguera_env_brdf, ["f0", "scale", "bias"]),
+    "fdez_aguera_area": (multiscatter.fdez_aguera_area_scale, ["f0", "e"]),
+    "cod_diffuse": (lambda mu_l, mu_v, n_dot_h, l_dot_h, r: diffuse.cod_multiscatter_diffuse(
+        0.8, mu_l, mu_v, n_dot_h, l_dot_h, alpha_from_roughness(r)), ["mu_l", "mu_v", "n_dot_h", "l_dot_h", "r"]),
+    "wrapped_diffuse": (diffuse.wrapped_diffuse_cosine, ["mu_l", "wrap"]),
+    "cloth": (lambda mu_l, mu_v, n_dot_h, r: cloth.ashikhmin_cloth_brdf(mu_l, mu_v, n_dot_h, alpha_from_roughness(r)),
+              ["mu_l", "mu_v", "n_dot_h", "r"]),
+    "disney_sheen": (cloth.disney_sheen, ["l_dot_h"]),
+    "window_falloff": (falloff.window_falloff, ["distance", "radius"]),
+    "inverse_square": (lambda distance: falloff.inverse_square_falloff(distance), ["distance"]),
+    "cone_falloff": (falloff.cone_falloff, ["cos_to_axis", "inner_angle", "outer_angle"]),
+    "projector_distance": (falloff.projector_distance, ["diameter", "outer_angle"]),
+}
+
+
+def technique_inputs(names, n=4000, seed=0):
+    rng = np.random.default_rng(seed)
+    extremes = np.array([0.0, 1e-7, 1e-4, 0.5, 1.0 - 1e-7, 1.0])
+    vals = {}
+    for i, name in enumerate(names):
+        # cosines also below the horizon; every other parameter in its domain [0, 1]
+        cosine = name.startswith(("mu", "n_dot", "v_dot", "l_dot", "cos"))
+        x = rng.uniform(-0.1 if cosine else 0.0, 1.0, n)
+        x[: extremes.size * 2] = np.concatenate([extremes, np.roll(extremes, i + 1)])
+        if name in ("distance", "radius", "diameter"):
+            x = np.abs(x) * 5
+        if name in ("inner_angle", "outer_angle"):
+            x = np.abs(x) * 3.0
+        if name == "one_minus_e_avg":    # the table's range: 1.3e-5 (r = 0) .. 0.59 (r = 1)
+            x = np.clip(x, 1e-5, 0.6)
+        vals[name] = x
+    return vals
+
+
+def punctual_lobe_inputs(seed=3, size=SIZE):
+    """Per-texel N, V, L, roughness and wrap for the punctual lobes, edge cases in the first texels."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    z = [0.0, 0.0, 1.0]
+    n = unit_vectors(rng, shape, special=[z] * 8)
+    v = unit_vectors(rng, shape, special=[z, z, [1, 0, 0], [0, 0, -1], z, [0.6, 0, 0.8], z, z])
+    l = unit_vectors(rng, shape, special=[z, [0, 0, -1], z, z, [1, 0, 0], [-0.6, 0, 0.8], [0, 0, -1], z])
+    # view above the normal in most texels (the material sees front faces), some below
+    flip = np.einsum("...i,...i->...", n, v) < 0
+    v[flip[..., None].repeat(3, -1) & (rng.random(shape) < 0.8)[..., None].repeat(3, -1)] *= -1
+    r = rng.random(shape).astype(np.float32)
+    r.reshape(-1)[:8] = [0.0, 1.0, 0.0, 1.0, 0.5, 0.0, 1e-3, 1.0]
+    wrap = rng.random(shape).astype(np.float32)
+    wrap.reshape(-1)[:3] = [0.0, 1.0, 1.0]
+    return {"N": n, "V": v, "L": l, "Roughness": r, "Wrap": wrap}
+
+
+def area_lobe_inputs(kind, seed=5, size=SIZE):
+    """Shading points on the unit sphere seen from outside; lights of many sizes, tilts and
+    positions, some below the horizon, in the tangent plane, or degenerate."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    count = size * size
+    n = unit_vectors(rng, shape).reshape(-1, 3)
+    p = n.copy()
+    v = n + rng.normal(size=(count, 3)) * 0.6
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    center = p + rng.normal(size=(count, 3)) * 2.0
+    center[:8] = p[:8] + n[:8] * np.array([2.0, -1.0, 0.0, 1e-3, 5.0, 0.5, 1.0, 2.0])[:, None]   # above, below,
+    u = rng.normal(size=(count, 3)) * rng.uniform(0.01, 1.5, (count, 1))                        # in plane, ...
+    w = rng.normal(size=(count, 3))
+    w -= u * (np.sum(u * w, -1) / np.maximum(np.sum(u * u, -1), 1e-12))[:, None]
+    w *= rng.uniform(0.01, 1.5, (count, 1)) / np.maximum(np.linalg.norm(w, axis=-1, keepdims=True), 1e-12)
+    u[8], w[8] = 0.0, 0.0                        # degenerate: zero size
+    u[9], w[9] = [1e-4, 0, 0], [0, 1e-4, 0]      # tiny
+    r = rng.random(count)
+    r[:6] = [0.0, 1.0, 0.0, 1.0, 0.5, 1e-3]
+    vals = {"Position": p, "N": n, "V": v, "Roughness": r, "Wrap": rng.random(count)}
+    if kind == "quad":
+        corners = [center - u - w, center + u - w, center + u + w, center - u + w]
+        vals.update({f"p{i}": c for i, c in enumerate(corners)})
+    else:
+        vals.update({"Center": center, "Axis U": u, "Axis V": w})
+    return {k: np.asarray(a, np.float32).reshape(shape + np.shape(a)[1:]) for k, a in vals.items()}
