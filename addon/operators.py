@@ -24,6 +24,14 @@ def _summarise(statuses, states):
     return "; ".join(parts)
 
 
+def _scene_exists(cls, context):
+    """poll() of the operators that work on the active scene."""
+    if context.scene is None:
+        cls.poll_message_set("No active scene")
+        return False
+    return True
+
+
 def _lut_directory_exists(cls, context):
     """poll() of the operators that read the LUT folder: it must exist."""
     lut_dir = preferences.lut_directory(context)
@@ -100,10 +108,7 @@ class RTL_OT_sync_lights(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        if context.scene is None:
-            cls.poll_message_set("No active scene")
-            return False
-        return True
+        return _scene_exists(cls, context)
 
     def execute(self, context):
         from . import materials
@@ -177,10 +182,7 @@ class RTL_OT_sync_world(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        if context.scene is None:
-            cls.poll_message_set("No active scene")
-            return False
-        return True
+        return _scene_exists(cls, context)
 
     def execute(self, context):
         from . import materials

@@ -4,10 +4,14 @@ from __future__ import annotations
 import bpy
 
 
-class RTL_PT_material(bpy.types.Panel):
+class _PropertiesPanel:
+    """An "RT Lookdev" panel of the Properties editor (the context is set by each panel)."""
     bl_label = "RT Lookdev"
     bl_space_type = 'PROPERTIES'
     bl_region_type = 'WINDOW'
+
+
+class RTL_PT_material(_PropertiesPanel, bpy.types.Panel):
     bl_context = "material"
 
     @classmethod
@@ -34,11 +38,8 @@ class RTL_PT_material(bpy.types.Panel):
         layout.operator("rtl.lut_status", icon='IMAGE_DATA')
 
 
-class RTL_PT_world(bpy.types.Panel):
+class RTL_PT_world(_PropertiesPanel, bpy.types.Panel):
     """The World term of RT Lit: whether the world can be used, and the sync button."""
-    bl_label = "RT Lookdev"
-    bl_space_type = 'PROPERTIES'
-    bl_region_type = 'WINDOW'
     bl_context = "world"
 
     @classmethod

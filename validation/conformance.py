@@ -167,15 +167,11 @@ def _build_plane_and_camera(bpy, scene, mat, h, w, created):
 
 def _build_black_world(bpy, scene, created):
     """A black world (colour and any Background node at 0), made the scene's world."""
+    from .render_setup import blacken_world
+
     world = bpy.data.worlds.new("RTL_conformance_world")
     created["worlds"].append(world)
-    world.color = (0.0, 0.0, 0.0)
-    if world.node_tree is not None:
-        for n in world.node_tree.nodes:
-            if n.bl_idname == "ShaderNodeBackground":
-                n.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-                n.inputs["Strength"].default_value = 0.0
-    scene.world = world
+    scene.world = blacken_world(world)
 
 
 def _render(bpy, scene, w, h, path, engine):

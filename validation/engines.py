@@ -227,3 +227,35 @@ def camera_incoming(scene, position):
         return np.broadcast_to(-forward / np.linalg.norm(forward), np.shape(position)).astype(np.float64)
     d = mw[:3, 3] - np.asarray(position, np.float64)
     return d / np.maximum(np.linalg.norm(d, axis=-1, keepdims=True), 1e-30)
+
+
+_RELOAD_CODE = """
+import json, sys
+import bpy
+bpy.context.preferences.filepaths.use_scripts_auto_execute = False
+bpy.ops.wm.open_mainfile(filepath=sys.argv[1], load_ui=False, use_scripts=False)
+import numpy as np
+from rt_lookdev.validation.engines import render_cycles_passes
+drivers = [fc.driver for ng in bpy.data.node_groups if ng.animation_data for fc in ng.animation_data.drivers]
+np.save(sys.argv[2], render_cycles_passes(bpy.context.scene, (int(sys.argv[3]), int(sys.argv[4])))["Combined"])
+print("RTL_RESULT " + json.dumps({"autoexec_fail": bpy.app.autoexec_fail, "drivers": len(drivers),
+      "simple": all(d.is_simple_expression for d in drivers), "valid": all(d.is_valid for d in drivers)}))
+"""
+
+
+def render_reloaded(blend, resolution, timeout=300):
+    """Open ``blend`` in a fresh process with Python auto-run off (as a user's Blender would) and render
+    it as ``render_cycles_passes``: (Combined (H, W, 3), {"autoexec_fail", "drivers", "simple", "valid"}:
+    whether a script was blocked, and the count and state of the drivers in node groups)."""
+    import json
+
+    w, h = resolution
+    with tempfile.TemporaryDirectory(prefix="rtl-reload-") as tmp:
+        out = Path(tmp) / "reloaded.npy"
+        proc = subprocess.run([sys.executable, "-c", _RELOAD_CODE, str(blend), str(out), str(w), str(h)],
+                              capture_output=True, text=True, timeout=timeout)
+        lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RTL_RESULT ")]
+        if proc.returncode != 0 or not lines:
+            raise RuntimeError(f"reloading {blend} failed (exit {proc.returncode}):\n"
+                               f"{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
+        return np.load(out), json.loads(lines[0][len("RTL_RESULT "):])

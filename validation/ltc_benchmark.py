@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import report
+
 from . import png as _png
 
 from ..core import energy  # noqa: E402
@@ -355,11 +357,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def _log(line):
-    print(line, flush=True)
-
-
-def run(args, log=_log):
+def run(args, log=report.flush_log):
     """Measure, write ltc.json, ltc.md and the heat maps to ``args.out``; returns the results."""
     args.out.mkdir(parents=True, exist_ok=True)
     import os

@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import report
+
 
 from ..core import energy
 from ..core import energy_checks as validation  # noqa: E402
@@ -144,11 +146,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def _log(line):
-    print(line, flush=True)
-
-
-def run(args, log=_log):
+def run(args, log=report.flush_log):
     """Measure, write luts.json and luts.md to ``args.out``; returns the results."""
     args.out.mkdir(parents=True, exist_ok=True)
     res = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",

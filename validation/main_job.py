@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import report
+
 
 from ..core import multiscatter
 from ..core import energy_checks as validation  # noqa: E402
@@ -48,11 +50,7 @@ LTC_MEDIAN_TOL = {"ggx": 0.015, "cod_diffuse": 0.01, "cloth": 0.01}   # quads, l
 LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main job
 
 
-def _log(line):
-    print(line, flush=True)
-
-
-def step_luts(lut_dir, log=_log):
+def step_luts(lut_dir, log=report.flush_log):
     log(f"[1/8] LUTs in {lut_dir}")
 
     def progress(group, done, total):
@@ -66,7 +64,7 @@ def step_luts(lut_dir, log=_log):
             "passed": all(s.state == "ok" for s in status)}
 
 
-def step_numpy_checks(lut_dir, log=_log):
+def step_numpy_checks(lut_dir, log=report.flush_log):
     log("[2/8] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
@@ -97,7 +95,7 @@ def step_numpy_checks(lut_dir, log=_log):
     return out
 
 
-def step_demo(out_dir, lut_dir, eevee=True, log=_log):
+def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
     log("[5/8] demo lookdev scene: build, node counts, Cycles and EEVEE renders")
     from . import demo_measure as demo_report
 
@@ -106,34 +104,36 @@ def step_demo(out_dir, lut_dir, eevee=True, log=_log):
     return result
 
 
-def step_validation(out_dir, lut_dir, log=_log):
-    log("[6/8] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
-    from . import suite as validate
-
-    argv = ["--out", str(out_dir / "validation")] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
-    result = validate.run(validate.parse_args(argv), log=lambda line: log("      " + line))
+def _run_suite(module, folder, lut_dir, log):
+    """Run a validation module (``suite`` or ``world_suite``) into ``folder``: (result, checks table)."""
+    argv = ["--out", str(folder)] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
+    result = module.run(module.parse_args(argv), log=lambda line: log("      " + line))
     lines = ["| check | measured | threshold | |", "|---|---|---|---|"]
     lines += [f"| {c['name']} | {c['measured']} | {c['threshold']} | {'ok' if c['ok'] else '**FAIL**'} |"
               for c in result["checks"]]
+    return result, lines
+
+
+def step_validation(out_dir, lut_dir, log=report.flush_log):
+    log("[6/8] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
+    from . import suite
+
+    result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
     return {"passed": bool(result["passed"]), "checks": result["checks"],
             "summary_markdown": "\n".join(lines) + f"\n\nFull report: `{out_dir / 'validation' / 'report.html'}`."}
 
 
-def step_world_validation(out_dir, lut_dir, log=_log):
+def step_world_validation(out_dir, lut_dir, log=report.flush_log):
     log("[7/8] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
-    from . import world_suite as validate_world
+    from . import world_suite
 
-    argv = ["--out", str(out_dir / "validation_world")] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
-    result = validate_world.run(validate_world.parse_args(argv), log=lambda line: log("      " + line))
-    lines = ["| check | measured | threshold | |", "|---|---|---|---|"]
-    lines += [f"| {c['name']} | {c['measured']} | {c['threshold']} | {'ok' if c['ok'] else '**FAIL**'} |"
-              for c in result["checks"]]
+    result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
     report_md = out_dir / "validation_world" / "report.md"
     return {"passed": bool(result["passed"]), "checks": result["checks"],
             "summary_markdown": "\n".join(lines) + f"\n\nFull report (per HDRI and roughness): `{report_md}`."}
 
 
-def step_render(out_dir, lut_dir, resolution, samples, log=_log):
+def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
     log("[4/8] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
     from . import energy_render as validate_energy
 
@@ -144,7 +144,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=_log):
     return result
 
 
-def step_ltc(lut_dir, log=_log):
+def step_ltc(lut_dir, log=report.flush_log):
     log("[3/8] LTC area lights: random quads and disks vs brute force")
     from . import ltc_benchmark as benchmark_ltc
 
@@ -157,16 +157,16 @@ def step_ltc(lut_dir, log=_log):
     return out
 
 
-def write_report(report, out_dir):
+def write_report(job, out_dir):
     out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "report.json").write_text(json.dumps(report, indent=2, default=float))
-    n = report["numpy_checks"]
+    (out_dir / "report.json").write_text(json.dumps(job, indent=2, default=float))
+    n = job["numpy_checks"]
     c = n["cycles_table"]
     lines = ["# RT Lookdev report", "",
-             f"Generated by `bash scripts/main.sh` on {report['date']} in {report['seconds']:.0f} s.", "",
+             f"Generated by `bash scripts/main.sh` on {job['date']} in {job['seconds']:.0f} s.", "",
              "## LUTs", ""]
-    lines += [f"- `{name}`: {state}" for name, state in report["luts"]["status"].items()]
-    lines += ["- bake: " + ", ".join(f"{r['group']} {r['state']} ({r['seconds']} s)" for r in report["luts"]["records"]),
+    lines += [f"- `{name}`: {state}" for name, state in job["luts"]["status"].items()]
+    lines += ["- bake: " + ", ".join(f"{r['group']} {r['state']} ({r['seconds']} s)" for r in job["luts"]["records"]),
               "", "## Energy (numpy)", "",
               "| check | value | acceptance |", "|---|---|---|",
               f"| max abs(E - Cycles table), integrator | {c['max_abs_diff_E_integrated']:.2e} | < {E_VS_CYCLES_TOL} |",
@@ -182,7 +182,7 @@ def write_report(report, out_dir):
               f"| Kulla-Conty furnace with the talk's polynomial as E_avg, mu >= 0.1 | "
               f"{n['talk_polynomial']['furnace_max_err_mu_ge_0.1']:.3f} | reported (why the table's E_avg ships) |",
               ""]
-    ltc = report["ltc"]
+    ltc = job["ltc"]
     lines += ["## LTC area lights (numpy, seeded random lights vs brute force)", "",
               f"{ltc['lights_per_brdf']['quads']} quads and {ltc['lights_per_brdf']['disks']} disks per BRDF; relative "
               "error on lights carrying > 10% of the lobe's albedo (acceptance: median of quads "
@@ -213,7 +213,7 @@ def write_report(report, out_dir):
     world = report.get("world_validation")
     lines += ["## World validation (the World term under the studio HDRIs)", ""]
     lines += [world["summary_markdown"], ""] if world else ["Skipped (--skip-render).", ""]
-    lines += [f"Overall: **{'PASS' if report['passed'] else 'FAIL'}**", ""]
+    lines += [f"Overall: **{'PASS' if job['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
 
@@ -229,35 +229,35 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def _passed(report):
+def _passed(job):
     """Every step passed (a skipped render step, None, counts as passed)."""
-    return bool(report["luts"]["passed"] and report["numpy_checks"]["passed"] and report["ltc"]["passed"]
-                and all(report[k] is None or report[k].get("passed", False)
+    return bool(job["luts"]["passed"] and job["numpy_checks"]["passed"] and job["ltc"]["passed"]
+                and all(job[k] is None or job[k].get("passed", False)
                         for k in ("render", "demo", "validation", "world_validation")))
 
 
-def run(args, log=_log):
+def run(args, log=report.flush_log):
     """Every step, then the report (``args.out``/report.md, report.json).  Returns the report dict; when
     the LUTs are not usable, stops after step 1 with ``{"luts": ..., "passed": False}`` (no report)."""
     t0 = time.perf_counter()
-    report = {"date": time.strftime("%Y-%m-%d %H:%M:%S")}
-    report["luts"] = step_luts(args.lut_dir, log)
-    if not report["luts"]["passed"]:
+    job = {"date": time.strftime("%Y-%m-%d %H:%M:%S")}
+    job["luts"] = step_luts(args.lut_dir, log)
+    if not job["luts"]["passed"]:
         print("LUTs are not usable; see the status above", file=sys.stderr)
-        report["passed"] = False
-        return report
-    report["numpy_checks"] = step_numpy_checks(args.lut_dir, log)
-    report["ltc"] = step_ltc(args.lut_dir, log)
-    report["render"] = report["demo"] = report["validation"] = report["world_validation"] = None
+        job["passed"] = False
+        return job
+    job["numpy_checks"] = step_numpy_checks(args.lut_dir, log)
+    job["ltc"] = step_ltc(args.lut_dir, log)
+    job["render"] = job["demo"] = job["validation"] = job["world_validation"] = None
     if not args.skip_render:
-        report["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
-        report["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
-        report["validation"] = step_validation(args.out, args.lut_dir, log)
-        report["world_validation"] = step_world_validation(args.out, args.lut_dir, log)
-    report["passed"] = _passed(report)
-    report["seconds"] = time.perf_counter() - t0
+        job["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
+        job["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+        job["validation"] = step_validation(args.out, args.lut_dir, log)
+        job["world_validation"] = step_world_validation(args.out, args.lut_dir, log)
+    job["passed"] = _passed(job)
+    job["seconds"] = time.perf_counter() - t0
     log("[8/8] report")
-    write_report(report, args.out)
+    write_report(job, args.out)
     log((args.out / "report.md").read_text())
     log(f"report written to {args.out / 'report.md'} and report.json")
-    return report
+    return job

@@ -104,7 +104,11 @@ def configure_eevee_measurement(scene, samples=1, filter_size=0.0, black_world=T
 def _black_world():
     import bpy
 
-    world = bpy.data.worlds.get("RTL_black_world") or bpy.data.worlds.new("RTL_black_world")
+    return blacken_world(bpy.data.worlds.get("RTL_black_world") or bpy.data.worlds.new("RTL_black_world"))
+
+
+def blacken_world(world):
+    """``world`` with a black colour and every Background node at colour 0, strength 0."""
     world.color = (0.0, 0.0, 0.0)
     if world.node_tree is not None:
         for node in world.node_tree.nodes:

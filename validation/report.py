@@ -12,6 +12,11 @@ from . import exr_images
 from . import png as _png
 
 
+def flush_log(line):
+    """The default ``log`` of long runs: print at once (progress shows while a job runs)."""
+    print(line, flush=True)
+
+
 def json_default(o):
     """``json.dumps(default=...)`` for numpy scalars and arrays and paths."""
     if isinstance(o, (np.bool_, np.integer, np.floating)):

@@ -35,6 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import report
+
 
 REPO = Path(__file__).resolve().parents[1]
 MAX_LIGHTS = 64
@@ -247,10 +249,6 @@ def _ratio(a, b):
     return a / b if a is not None and b else None
 
 
-def _log(line):
-    print(line, flush=True)
-
-
 def feature_sets(only=None):
     """The measured feature sets; with ``only``, those whose label contains one of its strings."""
     from ..core.materials.rt_lit_interface import Features
@@ -394,7 +392,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(args, log=_log):
+def run(args, log=report.flush_log):
     """Measure every feature set, write rt_lit.json and rt_lit.md to ``args.out``; returns the JSON's dict."""
     reps = args.repeats
     rows = []

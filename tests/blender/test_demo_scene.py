@@ -2,9 +2,6 @@
 and its Principled materials survive the round trip through RT Lit."""
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -28,7 +25,7 @@ def test_demo_scene_round_trips_and_reloads(empty_scene, lut_dir, tmp_path):
 
     from rt_lookdev.addon import convert
     from rt_lookdev.addon import demo_scene as build_demo_scene
-    from rt_lookdev.validation.engines import render_cycles_passes
+    from rt_lookdev.validation.engines import render_cycles_passes, render_reloaded
 
     spheres = build_demo_scene.build_demo_scene(lut_dir, resolution=80)
     scene = bpy.context.scene
@@ -39,22 +36,8 @@ def test_demo_scene_round_trips_and_reloads(empty_scene, lut_dir, tmp_path):
 
     blend = tmp_path / "demo.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
-    out = tmp_path / "reloaded.npy"
-    code = f"""
-import json
-import bpy
-bpy.context.preferences.filepaths.use_scripts_auto_execute = False
-bpy.ops.wm.open_mainfile(filepath={str(blend)!r}, load_ui=False, use_scripts=False)
-import numpy as np
-from rt_lookdev.validation.engines import render_cycles_passes
-np.save({str(out)!r}, render_cycles_passes(bpy.context.scene, {res!r})["Combined"])
-print("RTL_RESULT " + json.dumps({{"autoexec_fail": bpy.app.autoexec_fail}}))
-"""
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RTL_RESULT ")]
-    assert proc.returncode == 0 and lines, proc.stdout[-2000:] + proc.stderr[-2000:]
-    assert not json.loads(lines[0][len("RTL_RESULT "):])["autoexec_fail"]
-    there = np.load(out)
+    there, info = render_reloaded(blend, res)
+    assert not info["autoexec_fail"]
     print(f"demo reloaded in a fresh process: max |difference| {np.abs(there - here).max():.3g}")
     np.testing.assert_allclose(there, here, rtol=0, atol=1e-5)
 

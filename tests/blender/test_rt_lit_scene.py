@@ -3,15 +3,12 @@ numpy; lights and world that move or change; save and reload without Python; fol
 content."""
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 from rt_lookdev.validation import lit_scene as rt_lit_scene
-from rt_lookdev.validation.engines import render_cycles_passes
+from rt_lookdev.validation.engines import render_cycles_passes, render_reloaded
 
 pytest.importorskip("OpenEXR")
 
@@ -87,27 +84,8 @@ def test_scene_reloads_without_python_and_renders_identically(empty_scene, lut_d
     here = render_cycles_passes(scene, res)["Combined"]
     blend = tmp_path / "rt_lit.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
-    out = tmp_path / "reloaded.npy"
-    code = f"""
-import json
-import bpy
-bpy.context.preferences.filepaths.use_scripts_auto_execute = False
-bpy.ops.wm.open_mainfile(filepath={str(blend)!r}, load_ui=False, use_scripts=False)
-import numpy as np
-from rt_lookdev.validation.engines import render_cycles_passes
-scene = bpy.context.scene
-drivers = [fc.driver for ng in bpy.data.node_groups if ng.animation_data for fc in ng.animation_data.drivers]
-img = render_cycles_passes(scene, {res!r})["Combined"]
-np.save({str(out)!r}, img)
-print("RTL_RESULT " + json.dumps({{"autoexec_fail": bpy.app.autoexec_fail, "drivers": len(drivers),
-      "simple": all(d.is_simple_expression for d in drivers), "valid": all(d.is_valid for d in drivers)}}))
-"""
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("RTL_RESULT ")]
-    assert proc.returncode == 0 and lines, proc.stdout[-2000:] + proc.stderr[-2000:]
-    info = json.loads(lines[0][len("RTL_RESULT "):])
+    there, info = render_reloaded(blend, res)
     assert info["drivers"] > 0 and info["simple"] and info["valid"] and not info["autoexec_fail"]
-    there = np.load(out)
     print(f"max |reloaded - original| = {np.abs(there - here).max():.3g}")
     np.testing.assert_allclose(there, here, rtol=0, atol=1e-5)   # across processes: <= 8e-7 measured
 
