@@ -6,7 +6,7 @@ tuple (in order) and unregisters them in reverse.  Registration does no file I/O
 """
 import bpy
 
-from . import convert, operators, preferences, ui
+from . import compat, convert, operators, preferences, ui
 
 classes = (
     *operators.classes,
@@ -17,6 +17,10 @@ classes = (
 
 
 def register():
+    """Register every class; on a Blender older than ``compat.MINIMUM_VERSION`` refuse with a message
+    naming the supported releases (Blender shows it where the add-on is enabled), registering nothing."""
+    if not compat.supported():
+        raise RuntimeError(compat.unsupported_message())
     for cls in classes:
         bpy.utils.register_class(cls)
 

@@ -52,7 +52,8 @@ VARIANTS = (
 
 
 def _principled(bpy, name, values):
-    mat = bpy.data.materials.new(name)
+    from . import compat
+    mat = compat.new_material(name)
     nodes = mat.node_tree.nodes
     bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
     for key, value in values.items():
@@ -97,9 +98,10 @@ WORLD_ROTATION_Z = 1.2          # radians, the Mapping node's Z rotation
 
 def add_hdri_world(bpy, scene, hdri, strength, rotation_z=WORLD_ROTATION_Z):
     """World = Background(strength) <- Environment Texture(hdri) <- Mapping(rotation) <- Generated."""
+    from . import compat
     from ..core.environment import equirect
 
-    world = bpy.data.worlds.new(f"HDRI {hdri}")
+    world = compat.new_world(f"HDRI {hdri}")
     scene.world = world
     nt = world.node_tree
     nt.nodes.clear()

@@ -24,7 +24,7 @@ from ..core.lut.lookup import LutSet
 from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, RT_LIT_OUTPUTS,
                                                Features, light_input, rt_lit_group_name)
-from . import node_emit, world_sync
+from . import compat, node_emit, world_sync
 from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP,
                      WORLD_GROUP, add_driver, ensure_interface, remove_drivers, socket_by_identifier)
 
@@ -193,7 +193,7 @@ def rebuild_rt_lit_groups(scene, lut_dir=None):
 def assign_rt_lit(material, features=None, scene=None, lut_dir=None):
     """Make ``material`` an RT Lit material: RT Lit group (Shader) -> Material Output."""
     ng = ensure_rt_lit_group(features, scene, lut_dir)
-    nt = material.node_tree
+    nt = compat.ensure_node_tree(material)
     nodes = nt.nodes
     group = nodes.get(RT_LIT_NODE_NAME)
     if group is None:

@@ -41,6 +41,7 @@ from ..core.environment import equirect, prefilter
 from ..core.ir.expr import FLOAT, VECTOR
 from ..core.materials.rt_lit_interface import world_input
 from ..core.materials.world_shading import SH_NAMES, WORLD_PARAMETERS, WorldEnvironment
+from . import compat
 from .common import (IMAGE_PREFIX, NODE_GROUP_PREFIX, WORLD_GROUP, WORLD_RECORD_KEY, add_driver, ensure_interface,
                      remove_drivers, socket_by_identifier)
 
@@ -95,9 +96,7 @@ def _describe(node):
 
 
 def _uses_nodes(world):
-    if bpy.app.version >= (5, 0, 0):
-        return True          # deprecated in 5.0, always True (setting False is ignored)
-    return bool(world.use_nodes)
+    return compat.uses_nodes(world)
 
 
 def working_space():

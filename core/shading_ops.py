@@ -29,7 +29,10 @@ def _node(op, *args):
 
 
 def _arr(x):
-    """Float array view of x: float32/float64 kept, Python numbers and integers become float64."""
+    """x for numpy: Python numbers stay Python floats (weak: they take the other operand's float dtype,
+    under numpy 1 and 2 alike), arrays keep a float dtype (integers become float64)."""
+    if isinstance(x, (bool, int, float)):
+        return float(x)
     a = np.asarray(x)
     return a if a.dtype.kind == "f" else a.astype(np.float64)
 
@@ -248,7 +251,7 @@ def component(v, axis):
     """Component 0/1/2 (x/y/z) of a vector (a Separate XYZ output in nodes)."""
     if is_expr(v):
         return _node("xyz"[axis], v)
-    return _arr(v)[..., axis]
+    return np.asarray(_arr(v))[..., axis]
 
 
 def vec3(x, y, z):
@@ -256,7 +259,7 @@ def vec3(x, y, z):
     if is_expr(x, y, z):
         g = graph_of(x, y, z)
         return g.make("combine", (x, y, z))
-    return np.stack(np.broadcast_arrays(_arr(x), _arr(y), _arr(z)), axis=-1)
+    return np.stack(np.broadcast_arrays(*semantics.as_floats(x, y, z)), axis=-1)
 
 
 def vmul(a, b):
@@ -275,7 +278,8 @@ def scale(v, s):
     """Vector v times scalar s (Vector Math "Scale")."""
     if is_expr(v, s):
         return _node("vscale", v, s)
-    return _arr(v) * _arr(s)[..., None]
+    v, s = semantics.as_floats(v, s)
+    return v * s[..., None]
 
 
 def normalize(v):

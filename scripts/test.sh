@@ -1,25 +1,96 @@
 #!/usr/bin/env bash
-# Run the test suite in the project venv:  bash scripts/test.sh [pytest args...]
-#   bash scripts/test.sh                    # all of tests/
-#   bash scripts/test.sh tests/blender -x   # only these paths
+# Run the test suite (pytest; extra args are passed through):
+#   bash scripts/test.sh                      # all of tests/, in the development environment (.venv)
+#   bash scripts/test.sh tests/blender -x     # only these paths
+#   bash scripts/test.sh --release 4.5 [...]  # in the environment of requirements/blender-4.5.lock
+#   bash scripts/test.sh --matrix [...]       # every supported release in turn, then a table of results
+#                                             # (out/matrix/matrix.md and .json)
 set -uo pipefail
-# shellcheck source=env.sh
-source "$(dirname "${BASH_SOURCE[0]}")/env.sh" || exit $?
-cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$repo" || exit 1
 
-# Default to tests/ unless a test path (file, dir or file::node) was passed.
-paths=(tests)
-for arg in "$@"; do
-    if [[ "$arg" != -* && -e "${arg%%::*}" ]]; then
-        paths=()
-        break
-    fi
+release=""
+matrix=0
+args=()
+while (($#)); do
+    case "$1" in
+        --release) release="${2:?--release needs a name, e.g. 4.5}"; shift 2 ;;
+        --release=*) release="${1#--release=}"; shift ;;
+        --matrix) matrix=1; shift ;;
+        *) args+=("$1"); shift ;;
+    esac
 done
 
-python -m pytest "${paths[@]}" -q "$@"
-rc=$?
-if [[ $rc -eq 5 ]]; then
-    echo "test.sh: no tests were collected (pytest exit code 5); failing" >&2
-    exit 1
+lock_of() {  # the lock file of a release name ("" = the development environment)
+    if [[ -z "$1" ]]; then echo "$repo/requirements.lock"; else echo "$repo/requirements/blender-$1.lock"; fi
+}
+
+run_suite() {  # run_suite <release or ""> <junit xml or ""> [pytest args...]
+    local rel="$1" xml="$2"
+    shift 2
+    local lock
+    lock="$(lock_of "$rel")"
+    if [[ ! -f "$lock" ]]; then
+        echo "test.sh: no environment for release '$rel' ($lock is missing; have: $(ls "$repo"/requirements | tr '\n' ' '))" >&2
+        return 2
+    fi
+    (
+        export RTL_LOCK="$lock"
+        # shellcheck source=env.sh
+        source "$repo/scripts/env.sh" || exit $?
+        paths=(tests)
+        for arg in "$@"; do
+            if [[ "$arg" != -* && -e "${arg%%::*}" ]]; then
+                paths=()
+                break
+            fi
+        done
+        extra=()
+        [[ -n "$xml" ]] && extra=(--junitxml "$xml")
+        python -m pytest "${paths[@]}" -q "${extra[@]}" "$@"
+        rc=$?
+        if [[ -n "$xml" ]]; then   # what the environment is, for the matrix table
+            python -c 'import sys, numpy, importlib.metadata as m
+print(m.version("bpy"), "%d.%d.%d" % sys.version_info[:3], numpy.__version__)' >"${xml%.xml}.env"
+        fi
+        if [[ $rc -eq 5 ]]; then
+            echo "test.sh: no tests were collected (pytest exit code 5); failing" >&2
+            exit 1
+        fi
+        exit $rc
+    )
+}
+
+if ((matrix == 0)); then
+    run_suite "$release" "" "${args[@]+"${args[@]}"}"
+    exit $?
 fi
-exit $rc
+
+# --- the version matrix ---------------------------------------------------------------------------
+out="$repo/out/matrix"
+mkdir -p "$out"
+releases=("")
+for lock in "$repo"/requirements/blender-*.lock; do
+    name="$(basename "$lock" .lock)"
+    releases+=("${name#blender-}")
+done
+status=0
+for rel in "${releases[@]}"; do
+    label="${rel:-dev}"
+    if [[ -n "$rel" ]]; then
+        echo "=== test.sh --matrix: Blender $rel (requirements/blender-$rel.lock)"
+    else
+        echo "=== test.sh --matrix: the development environment (requirements.lock)"
+    fi
+    start=$(date +%s)
+    run_suite "$rel" "$out/$label.xml" "${args[@]+"${args[@]}"}"
+    rc=$?
+    echo "$rc $(($(date +%s) - start))" >"$out/$label.rc"
+    ((rc == 0)) || status=1
+done
+(
+    export RTL_LOCK="$(lock_of "")"
+    source "$repo/scripts/env.sh" >/dev/null || exit $?
+    python -m rt_lookdev.validation.version_matrix "$out"
+) || status=1
+exit $status

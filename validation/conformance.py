@@ -121,7 +121,8 @@ def _link_emission_output(nt, out_socket, is_vector):
 def _build_material(bpy, ng, arrays, h, w, output_name, created):
     """The temporary material: input images -> group ``ng`` -> emission.  Returns (material, whether
     the output is read back as RGB: vector and colour outputs)."""
-    mat = bpy.data.materials.new("RTL_conformance")
+    from ..addon import compat
+    mat = compat.new_material("RTL_conformance")
     created["materials"].append(mat)
     nt = mat.node_tree
     nt.nodes.clear()
@@ -167,9 +168,10 @@ def _build_plane_and_camera(bpy, scene, mat, h, w, created):
 
 def _build_black_world(bpy, scene, created):
     """A black world (colour and any Background node at 0), made the scene's world."""
+    from ..addon import compat
     from .render_setup import blacken_world
 
-    world = bpy.data.worlds.new("RTL_conformance_world")
+    world = compat.new_world("RTL_conformance_world")
     created["worlds"].append(world)
     scene.world = blacken_world(world)
 

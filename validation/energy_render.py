@@ -100,14 +100,13 @@ def _uv_sphere_mesh(bpy, name, segments, rings):
 
 def build_scene(roughness, resolution, segments=256, rings=128):
     """Reset the file and build the spheres, world and camera.  Returns (scene, glossy nodes)."""
+    from ..addon import compat
     bpy = _bpy()
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
     n = len(roughness)
 
-    world = bpy.data.worlds.new("RTL_white_world")
-    if world.node_tree is None:
-        world.use_nodes = True
+    world = compat.new_world("RTL_white_world")
     wt = world.node_tree
     wt.nodes.clear()
     bg = wt.nodes.new("ShaderNodeBackground")
@@ -120,7 +119,7 @@ def build_scene(roughness, resolution, segments=256, rings=128):
     mesh = _uv_sphere_mesh(bpy, "RTL_sphere", segments, rings)
     glossies = []
     for i, r in enumerate(roughness):
-        mat = bpy.data.materials.new(f"RTL_glossy_{r:g}")
+        mat = compat.new_material(f"RTL_glossy_{r:g}")
         nt = mat.node_tree
         nt.nodes.clear()
         g = nt.nodes.new("ShaderNodeBsdfGlossy")
@@ -171,7 +170,8 @@ def build_scene(roughness, resolution, segments=256, rings=128):
 
 def configure_render(scene, samples, seed, threads=2):
     """Cycles settings for an unbiased, unclamped, point-sampled linear render
-    (addon/render_setup.py), plus what the furnace needs: glossy bounces, no glossy filter."""
+    (validation/render_setup.py), plus what the furnace needs: glossy bounces, no glossy filter."""
+    from ..addon import compat
     from .render_setup import configure_cycles_measurement
 
     configure_cycles_measurement(scene, samples, seed, threads)
@@ -188,9 +188,7 @@ def configure_render(scene, samples, seed, threads=2):
     scene.view_layers[0].use_pass_combined = True
     scene.view_layers[0].use_pass_normal = True
     s = scene.render.image_settings
-    s.media_type = "MULTI_LAYER_IMAGE"
-    s.file_format = "OPEN_EXR_MULTILAYER"
-    s.color_depth = "32"
+    compat.set_exr_output(s, multilayer=True)
     s.exr_codec = "ZIP"
 
 

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 
+from ..addon import compat
 from . import exr_images
 from .render_setup import (configure_cycles_measurement, configure_eevee_measurement,
                                            eevee_texture_filtering)
@@ -52,9 +53,7 @@ def output_settings(scene, w, h, filepath):
     r.use_compositing = False
     r.use_sequencer = False
     s = r.image_settings
-    s.media_type = "IMAGE"
-    s.file_format = "OPEN_EXR"
-    s.color_depth = "32"
+    compat.set_exr_output(s)
     s.color_mode = "RGBA"
     s.exr_codec = "ZIP"
     r.filepath = str(filepath)
@@ -145,7 +144,8 @@ scene = bpy.context.scene
 cam = bpy.data.objects.new("probe_camera", bpy.data.cameras.new("probe_camera"))
 scene.collection.objects.link(cam)
 scene.camera = cam
-scene.render.engine = "BLENDER_EEVEE"
+from rt_lookdev.addon import compat
+scene.render.engine = compat.eevee_engine()
 scene.eevee.taa_render_samples = 1
 r = scene.render
 r.resolution_x = r.resolution_y = 4
@@ -202,10 +202,7 @@ def render_cycles_passes(scene, resolution=(64, 64), path=None):
         output_settings(scene, w, h, exr)
         vl = scene.view_layers[0]
         vl.use_pass_position = vl.use_pass_normal = True
-        s = scene.render.image_settings
-        s.media_type = "MULTI_LAYER_IMAGE"
-        s.file_format = "OPEN_EXR_MULTILAYER"
-        s.color_depth = "32"
+        compat.set_exr_output(scene.render.image_settings, multilayer=True)
         t0 = time.perf_counter()
         bpy.ops.render.render(write_still=True, scene=scene.name)
         seconds = time.perf_counter() - t0

@@ -1,6 +1,7 @@
-"""Input grids of the conformance checks, shared by the tests of every backend (numpy, node groups).
+"""Input grids of the conformance checks, shared by the tests of every backend (numpy, node groups, GLSL).
 
-No bpy here: ``TECHNIQUES`` with ``technique_inputs`` (every technique's function and its argument grid,
+No bpy here: ``ir_operation_graph`` with ``ir_operation_inputs`` (every IR operation once, on a grid with
+exact zeros, +-1e-7, integers, zero vectors and out-of-domain values), ``TECHNIQUES`` with ``technique_inputs`` (every technique's function and its argument grid,
 with zeros, 1e-7 and the domain's edges), ``punctual_lobe_inputs`` and ``area_lobe_inputs`` (the lobes'
 per-texel inputs: edge cases, grazing and below-horizon views, lights below, in the plane of, or tiny).
 """
@@ -115,3 +116,51 @@ def area_lobe_inputs(kind, seed=5, size=SIZE):
     else:
         vals.update({"Center": center, "Axis U": u, "Axis V": w})
     return {k: np.asarray(a, np.float32).reshape(shape + np.shape(a)[1:]) for k, a in vals.items()}
+
+
+def ir_operation_inputs(size=64):
+    """size x size grid: a in [-3, 3] x b in [-2, 2] with exact zeros, integers and domain edges; random
+    vectors u, v with zero vectors in the first texels (normalize(0) = 0)."""
+    a = np.linspace(-3.0, 3.0, size, dtype=np.float32)
+    b = np.linspace(-2.0, 2.0, size, dtype=np.float32)
+    a[:8] = [0.0, -0.0, 1.0, -1.0, 2.0, 0.5, 1e-7, -1e-7]
+    b[:8] = [0.0, 2.0, -1.0, 3.0, 0.5, -0.5, 1.0, 1e-7]
+    A, B = np.meshgrid(a, b, indexing="xy")
+    rng = np.random.default_rng(7)
+    u = rng.normal(size=(size, size, 3)).astype(np.float32)
+    v = rng.normal(size=(size, size, 3)).astype(np.float32)
+    u[0, :4] = 0.0
+    return {"a": A, "b": B, "u": u, "v": v}
+
+
+def ir_operation_graph():
+    """One output per IR operation (every entry of ``expr.OPS`` but the table reads), inputs a, b (float)
+    and u, v (vector): {output name -> Expr}."""
+    from ..core.ir import Graph
+    from ..core.ir.expr import OPS, topological_order
+
+    g = Graph()
+    a, b, u, v = g.input("a"), g.input("b"), g.input("u", "vector"), g.input("v", "vector")
+    binary = ("add", "subtract", "multiply", "divide", "power", "minimum", "maximum", "less_than", "greater_than",
+              "arctan2")
+    unary = ("sqrt", "inverse_sqrt", "exponent", "log2", "absolute", "floor", "arccosine", "arcsine", "sine",
+             "cosine", "tangent")
+    outputs = {op: g.make(op, (a, b)) for op in binary}
+    outputs.update({op: g.make(op, (a,)) for op in unary})
+    cond = g.make("greater_than", (a, b))
+    outputs["select"] = g.make("select", (cond, a, g.make("multiply", (b, b))))
+    outputs["vselect"] = g.make("vselect", (cond, u, v))
+    outputs["combine"] = g.make("combine", (a, b, g.make("multiply", (a, b))))
+    for c in "xyz":
+        outputs[c] = g.make(c, (u,))
+    outputs.update({op: g.make(op, (u, v)) for op in ("vadd", "vsubtract", "vmultiply", "dot", "cross")})
+    outputs["vscale"] = g.make("vscale", (u, a))
+    outputs["length"] = g.make("length", (u,))
+    outputs["normalize"] = g.make("normalize", (u,))
+    outputs["const_arg"] = g.make("power", (g.const(2.0), a))          # a constant on a socket
+    outputs["vconst_arg"] = g.make("cross", (g.vconst((0.0, 0.0, 1.0)), u))
+    covered = {n.op for n in topological_order(list(outputs.values()))}
+    missing = set(OPS) - covered - {"lut", "texel"}
+    if missing:
+        raise AssertionError(f"operations not covered: {sorted(missing)}")
+    return outputs

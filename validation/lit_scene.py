@@ -27,6 +27,7 @@ def aim(obj, target=(0.0, 0.0, 0.0)):
 def build(features_by_material, kinds=None, resolution=48, hdri=None, world_strength=0.7, lut_dir=None):
     """Spheres side by side (one per (name, Features)) lit by the LIGHTS (``kinds`` filters them) and,
     with ``hdri``, by that studio HDRI's World term; RT Lit groups read the LUTs of ``lut_dir``."""
+    from ..addon import compat
     import bmesh
     import bpy
 
@@ -64,7 +65,7 @@ def build(features_by_material, kinds=None, resolution=48, hdri=None, world_stre
         bm.free()
         for poly in mesh.polygons:
             poly.use_smooth = True
-        mat = bpy.data.materials.new(name)
+        mat = compat.new_material(name)
         materials.assign_rt_lit(mat, features, scene, lut_dir)
         mesh.materials.append(mat)
         obj = bpy.data.objects.new(name, mesh)

@@ -194,7 +194,7 @@ def write_report(job, out_dir):
         lines.append(f"| {key} | {o['lights_over_10pct']}/{o['lights']} | {100 * o['rel_median']:.2f}% | "
                      f"{100 * o['rel_p90']:.1f}% | {100 * o['abs_over_albedo_median']:.2f}% |")
     lines.append("")
-    render = report.get("render")
+    render = job.get("render")
     lines += ["## Cycles render check (spheres under a white world)", ""]
     if render is None:
         lines += ["Skipped (--skip-render).", ""]
@@ -204,13 +204,13 @@ def write_report(job, out_dir):
                   f"{settings['seeds']}; per-bin acceptance |bias| <= {settings['z_max']} SE + {settings['sys_tol']} "
                   f"(GGX vs our E), Multiscatter GGX 1 +- {settings['ms_tol']}. Full numbers in "
                   f"energy_render/energy_validation.json.", "", render["summary_markdown"], ""]
-    demo = report.get("demo")
+    demo = job.get("demo")
     lines += ["## Demo lookdev scene (RT Lit materials)", ""]
     lines += [demo["summary_markdown"], ""] if demo else ["Skipped (--skip-render).", ""]
-    val = report.get("validation")
+    val = job.get("validation")
     lines += ["## Validation suite (node render, numpy, Cycles ground truth)", ""]
     lines += [val["summary_markdown"], ""] if val else ["Skipped (--skip-render).", ""]
-    world = report.get("world_validation")
+    world = job.get("world_validation")
     lines += ["## World validation (the World term under the studio HDRIs)", ""]
     lines += [world["summary_markdown"], ""] if world else ["Skipped (--skip-render).", ""]
     lines += [f"Overall: **{'PASS' if job['passed'] else 'FAIL'}**", ""]

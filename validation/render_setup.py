@@ -70,7 +70,9 @@ def configure_eevee_measurement(scene, samples=1, filter_size=0.0, black_world=T
     setting): with the default 2x anisotropic filtering, Linear lookups on llvmpipe are off by up to
     0.1 texel; without it they match exact bilinear filtering to the film's half precision.
     """
-    scene.render.engine = "BLENDER_EEVEE"
+    from ..addon import compat
+
+    scene.render.engine = compat.eevee_engine()
     e = scene.eevee
     e.taa_render_samples = int(samples)
     e.use_taa_reprojection = False
@@ -104,7 +106,9 @@ def configure_eevee_measurement(scene, samples=1, filter_size=0.0, black_world=T
 def _black_world():
     import bpy
 
-    return blacken_world(bpy.data.worlds.get("RTL_black_world") or bpy.data.worlds.new("RTL_black_world"))
+    from ..addon import compat
+
+    return blacken_world(bpy.data.worlds.get("RTL_black_world") or compat.new_world("RTL_black_world"))
 
 
 def blacken_world(world):

@@ -69,6 +69,7 @@ def _world(scene, mode):
 
 
 def _scene(features, count, world=NO_WORLD):
+    from ..addon import compat
     import bmesh
     import bpy
 
@@ -94,7 +95,7 @@ def _scene(features, count, world=NO_WORLD):
     bmesh.ops.create_uvsphere(bm, u_segments=32, v_segments=16, radius=1.0)
     bm.to_mesh(mesh)
     bm.free()
-    mat = bpy.data.materials.new("m")
+    mat = compat.new_material("m")
     materials.assign_rt_lit(mat, features, scene)
     node = mat.node_tree.nodes["RT Lit"]
     for k, v in VALUES.items():

@@ -283,6 +283,7 @@ def _aim(obj, target):
 
 def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
     """Reset the file; lights, spheres with RT Lit materials, camera.  Returns (scene, spheres)."""
+    from ..addon import compat
     import bpy
 
     from . import energy_render as validate_energy
@@ -318,7 +319,7 @@ def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
     spheres = []
     for i, (variant, centre) in enumerate(zip(case.variants, centres)):
         me = mesh.copy()
-        mat = bpy.data.materials.new(f"RTL_val_{i}")
+        mat = compat.new_material(f"RTL_val_{i}")
         materials.assign_rt_lit(mat, variant.features, scene, lut_dir)
         node = mat.node_tree.nodes["RT Lit"]
         for k, v in variant.material().items():
@@ -435,9 +436,9 @@ def conditioning(fn, passes, b=None):
 # --- (c) Cycles ground truth -----------------------------------------------------------------
 
 def _closure_material(variant, name):
-    import bpy
+    from ..addon import compat
 
-    mat = bpy.data.materials.new(name)
+    mat = compat.new_material(name)
     nt = mat.node_tree
     nt.nodes.clear()
     out = nt.nodes.new("ShaderNodeOutputMaterial")
@@ -491,6 +492,7 @@ def _closure_material(variant, name):
 
 
 def configure_truth_render(scene, samples, seed, threads=2):
+    from ..addon import compat
     from .render_setup import configure_cycles_measurement
 
     configure_cycles_measurement(scene, samples, seed, threads)
@@ -504,9 +506,7 @@ def configure_truth_render(scene, samples, seed, threads=2):
     vl.use_pass_normal = True
     vl.use_pass_position = False
     s = scene.render.image_settings
-    s.media_type = "MULTI_LAYER_IMAGE"
-    s.file_format = "OPEN_EXR_MULTILAYER"
-    s.color_depth = "32"
+    compat.set_exr_output(s, multilayer=True)
     s.exr_codec = "ZIP"
 
 

@@ -209,11 +209,10 @@ def write_constant_equirect(path, value=1.0, width=64, height=32):
 def setup_world(scene, spec):
     """scene.world = Generated -> Mapping (Point, spec.rotation) -> Environment Texture (spec.path,
     Linear) -> Background (spec.strength) -> World Output."""
+    from ..addon import compat
     import bpy
 
-    world = bpy.data.worlds.new(f"RTL_val_world_{spec.name}")
-    if world.node_tree is None:
-        world.use_nodes = True
+    world = compat.new_world(f"RTL_val_world_{spec.name}")
     nt = world.node_tree
     nt.nodes.clear()
     coords = nt.nodes.new("ShaderNodeTexCoord")
@@ -287,14 +286,12 @@ def sphere_mesh(segments=192, rings=96):
 
 def add_node_block(scene, variants, cell_px, columns, z0=0.0, lut_dir=None, mesh=None, name="node"):
     """RT Lit spheres (one per variant) in a grid centred at (0, 0, z0)."""
-    import bpy
-
-    from ..addon import materials
+    from ..addon import compat, materials
 
     mesh = mesh or sphere_mesh()
     objects = []
     for i, (variant, centre) in enumerate(zip(variants, cell_centres(len(variants), columns, z0))):
-        mat = bpy.data.materials.new(f"RTL_valw_{name}_{i}")
+        mat = compat.new_material(f"RTL_valw_{name}_{i}")
         materials.assign_rt_lit(mat, variant.features, scene, lut_dir)
         node = mat.node_tree.nodes["RT Lit"]
         for k, v in variant.material().items():

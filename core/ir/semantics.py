@@ -44,19 +44,36 @@ CALL = "call"   # the kind of a function-call node; its outputs are "output" nod
 
 # --- guarded scalar rules ---------------------------------------------------------------------------
 
-def _floats(*values):
-    """numpy arrays of a float dtype (float32 and float64 kept; Python numbers as float64)."""
-    out = []
+def float_dtype(*values):
+    """The float dtype an operation on ``values`` computes in, the same under numpy 1 and 2: arrays keep
+    their float dtype (integer and boolean ones count as float64); Python numbers, numpy scalars and 0-d
+    arrays are weak (they take the arrays' dtype, as numpy 1's value-based casting gave and as NEP 50 gives
+    numpy 2 only for Python numbers); values that are all weak give float64, or their own float dtype."""
+    arrays = []
     for v in values:
+        if isinstance(v, (bool, int, float)):
+            continue
         a = np.asarray(v)
-        out.append(a if a.dtype.kind == "f" else a.astype(np.float64))
-    return out
+        arrays.append(a if a.dtype.kind == "f" else a.astype(np.float64))
+    shaped = [a for a in arrays if a.ndim > 0]
+    if shaped:
+        return np.result_type(*shaped)
+    return np.result_type(*arrays) if arrays else np.dtype(np.float64)
+
+
+def as_floats(*values):
+    """``values`` as numpy arrays of one float dtype (``float_dtype``)."""
+    dtype = float_dtype(*values)
+    return [np.asarray(v, dtype=dtype) for v in values]
+
+
+_floats = as_floats
 
 
 def divide(a, b):
     """a / b, and 0 where b == 0 (Cycles ``safe_divide``)."""
     a, b = np.broadcast_arrays(*_floats(a, b))
-    out = np.zeros(a.shape, dtype=np.result_type(a, b))
+    out = np.zeros(a.shape, dtype=a.dtype)
     np.divide(a, b, out=out, where=(b != 0))
     return out
 
@@ -68,7 +85,7 @@ def power(a, b):
     bad = ((a < 0) & (b != np.floor(b))) | ((a == 0) & (b < 0))
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         out = np.power(np.where(bad, 1.0, a).astype(a.dtype), b)
-    return np.where(bad, 0.0, out).astype(np.result_type(a, b))
+    return np.where(bad, 0.0, out).astype(a.dtype)
 
 
 def sqrt(a):
@@ -189,15 +206,19 @@ def sample_bilinear(table, u, v):
 
 @dataclass(frozen=True)
 class Operation:
-    """One IR operation: argument kinds, result kind, numpy rule (None: structural), statement."""
+    """One IR operation: argument kinds, result kind, numpy rule (None: structural), statement, and the
+    operation in shader text (``text``: a template over the arguments ``{0}``, ``{1}``, ... and the
+    dialect's words ``{vec3}``, ``{atan2}``, ``{inversesqrt}``; None: structural).  A template that calls
+    ``rtl_*`` uses a helper of ``SHADER_HELPERS``: the guarded rule where the language's own differs."""
     args: tuple
     result: str
     numpy: object
     rule: str
+    text: str | None = None
 
 
-def _op(args, result, fn, rule):
-    return Operation(tuple(args), result, fn, rule)
+def _op(args, result, fn, rule, text=None):
+    return Operation(tuple(args), result, fn, rule, text)
 
 
 F, V = FLOAT, VECTOR
@@ -209,47 +230,99 @@ OPERATIONS = {
     "input": _op((), F, None, "a named float input"),
     "vinput": _op((), V, None, "a named vector input"),
     # Math node (ShaderNodeMath)
-    "add": _op((F, F), F, np.add, "a + b"),
-    "subtract": _op((F, F), F, np.subtract, "a - b"),
-    "multiply": _op((F, F), F, np.multiply, "a * b"),
-    "divide": _op((F, F), F, divide, "a / b; 0 where b == 0"),
-    "power": _op((F, F), F, power, "a ** b; 0 for a < 0 with fractional b, and for a == 0 with b < 0"),
-    "sqrt": _op((F,), F, sqrt, "sqrt(max(a, 0))"),
-    "inverse_sqrt": _op((F,), F, inverse_sqrt, "1/sqrt(a) for a > 0, else 0"),
-    "exponent": _op((F,), F, np.exp, "e ** a"),
-    "log2": _op((F,), F, log2, "log2(a) for a > 0, else 0"),
-    "minimum": _op((F, F), F, np.minimum, "min(a, b)"),
-    "maximum": _op((F, F), F, np.maximum, "max(a, b)"),
-    "less_than": _op((F, F), F, lambda a, b: (a < b).astype(np.result_type(a, b)), "1 if a < b else 0"),
-    "greater_than": _op((F, F), F, lambda a, b: (a > b).astype(np.result_type(a, b)), "1 if a > b else 0"),
-    "absolute": _op((F,), F, np.abs, "|a|"),
-    "floor": _op((F,), F, np.floor, "floor(a)"),
-    "arccosine": _op((F,), F, arccosine, "acos(clamp(a, -1, 1))"),
-    "arcsine": _op((F,), F, arcsine, "asin(clamp(a, -1, 1))"),
-    "sine": _op((F,), F, np.sin, "sin(a)"),
-    "cosine": _op((F,), F, np.cos, "cos(a)"),
-    "tangent": _op((F,), F, np.tan, "tan(a)"),
-    "arctan2": _op((F, F), F, np.arctan2, "atan2(a, b) (the angle of (b, a))"),
+    "add": _op((F, F), F, np.add, "a + b", "({0} + {1})"),
+    "subtract": _op((F, F), F, np.subtract, "a - b", "({0} - {1})"),
+    "multiply": _op((F, F), F, np.multiply, "a * b", "({0} * {1})"),
+    "divide": _op((F, F), F, divide, "a / b; 0 where b == 0", "rtl_div({0}, {1})"),
+    "power": _op((F, F), F, power, "a ** b; 0 for a < 0 with fractional b, and for a == 0 with b < 0",
+                 "rtl_pow({0}, {1})"),
+    "sqrt": _op((F,), F, sqrt, "sqrt(max(a, 0))", "sqrt(max({0}, 0.0))"),
+    "inverse_sqrt": _op((F,), F, inverse_sqrt, "1/sqrt(a) for a > 0, else 0", "rtl_inverse_sqrt({0})"),
+    "exponent": _op((F,), F, np.exp, "e ** a", "exp({0})"),
+    "log2": _op((F,), F, log2, "log2(a) for a > 0, else 0", "rtl_log2({0})"),
+    "minimum": _op((F, F), F, np.minimum, "min(a, b)", "min({0}, {1})"),
+    "maximum": _op((F, F), F, np.maximum, "max(a, b)", "max({0}, {1})"),
+    "less_than": _op((F, F), F, lambda a, b: (a < b).astype(np.result_type(a, b)), "1 if a < b else 0",
+                     "(({0} < {1}) ? 1.0 : 0.0)"),
+    "greater_than": _op((F, F), F, lambda a, b: (a > b).astype(np.result_type(a, b)), "1 if a > b else 0",
+                        "(({0} > {1}) ? 1.0 : 0.0)"),
+    "absolute": _op((F,), F, np.abs, "|a|", "abs({0})"),
+    "floor": _op((F,), F, np.floor, "floor(a)", "floor({0})"),
+    "arccosine": _op((F,), F, arccosine, "acos(clamp(a, -1, 1))", "rtl_acos({0})"),
+    "arcsine": _op((F,), F, arcsine, "asin(clamp(a, -1, 1))", "rtl_asin({0})"),
+    "sine": _op((F,), F, np.sin, "sin(a)", "sin({0})"),
+    "cosine": _op((F,), F, np.cos, "cos(a)", "cos({0})"),
+    "tangent": _op((F,), F, np.tan, "tan(a)", "tan({0})"),
+    "arctan2": _op((F, F), F, np.arctan2, "atan2(a, b) (the angle of (b, a)); atan2(+-0, +-0) = +-0 or +-pi",
+                   "rtl_atan2({0}, {1})"),
     # Mix node with a float factor: select(c, a, b) = mix(b, a, c) for c in {0, 1}
-    "select": _op((F, F, F), F, select, "a if c != 0 else b (Mix: exact for c in {0, 1})"),
-    "vselect": _op((F, V, V), V, vselect, "vector a if c != 0 else b"),
+    "select": _op((F, F, F), F, select, "a if c != 0 else b (Mix: exact for c in {0, 1})",
+                  "(({0} != 0.0) ? {1} : {2})"),
+    "vselect": _op((F, V, V), V, vselect, "vector a if c != 0 else b", "(({0} != 0.0) ? {1} : {2})"),
     # Image Texture at (u, v), one channel: attrs ("table", name), ("channel", 0..3)
     "lut": _op((F, F), F, None, "Linear, EXTEND: sample_bilinear(table, u, v)[channel]"),
     "texel": _op((F, F), F, None, "Closest, EXTEND: texel_fetch(table, u, v)[channel]"),
     # Combine / Separate XYZ
-    "combine": _op((F, F, F), V, combine, "(x, y, z)"),
-    "x": _op((V,), F, lambda v: v[..., 0], "v.x"),
-    "y": _op((V,), F, lambda v: v[..., 1], "v.y"),
-    "z": _op((V,), F, lambda v: v[..., 2], "v.z"),
+    "combine": _op((F, F, F), V, combine, "(x, y, z)", "{vec3}({0}, {1}, {2})"),
+    "x": _op((V,), F, lambda v: v[..., 0], "v.x", "{0}.x"),
+    "y": _op((V,), F, lambda v: v[..., 1], "v.y", "{0}.y"),
+    "z": _op((V,), F, lambda v: v[..., 2], "v.z", "{0}.z"),
     # Vector Math node (ShaderNodeVectorMath)
-    "vadd": _op((V, V), V, np.add, "a + b"),
-    "vsubtract": _op((V, V), V, np.subtract, "a - b"),
-    "vscale": _op((V, F), V, lambda v, s: v * np.asarray(s)[..., None], "v * s"),
-    "vmultiply": _op((V, V), V, np.multiply, "component-wise a * b"),
-    "dot": _op((V, V), F, dot, "a . b"),
-    "cross": _op((V, V), V, cross, "a x b"),
-    "length": _op((V,), F, length, "|v|"),
-    "normalize": _op((V,), V, normalize, "v / |v|; the zero vector for |v| == 0"),
+    "vadd": _op((V, V), V, np.add, "a + b", "({0} + {1})"),
+    "vsubtract": _op((V, V), V, np.subtract, "a - b", "({0} - {1})"),
+    "vscale": _op((V, F), V, lambda v, s: v * np.asarray(s)[..., None], "v * s", "({0} * {1})"),
+    "vmultiply": _op((V, V), V, np.multiply, "component-wise a * b", "({0} * {1})"),
+    "dot": _op((V, V), F, dot, "a . b", "dot({0}, {1})"),
+    "cross": _op((V, V), V, cross, "a x b", "cross({0}, {1})"),
+    "length": _op((V,), F, length, "|v|", "length({0})"),
+    "normalize": _op((V,), V, normalize, "v / |v|; the zero vector for |v| == 0", "rtl_normalize({0})"),
+}
+
+#: The guarded rules as shader functions, written in the subset GLSL (4.50, ES 3.00) and HLSL (SM 5) share;
+#: ``{vec3}`` and ``{inversesqrt}`` are the dialect's words.  Each states the rule of its operation above.
+SHADER_HELPERS = {
+    "rtl_div": ("float rtl_div(float a, float b)", "return (b != 0.0) ? a / b : 0.0;"),
+    # a ** b with Cycles' rules: 0 for 0 ** negative; a negative base needs an integer exponent (odd: -);
+    # x ** 0 = 1 for every x (C's powf; GLSL leaves pow(0, 0) undefined: llvmpipe gives 0)
+    "rtl_pow": ("float rtl_pow(float a, float b)",
+                "if (b == 0.0) return 1.0;\n"
+                "if (a == 0.0 && b < 0.0) return 0.0;\n"
+                "if (a < 0.0) {\n"
+                "    if (b != floor(b)) return 0.0;\n"
+                "    float r = pow(-a, b);\n"
+                "    return (b - 2.0 * floor(0.5 * b) != 0.0) ? -r : r;\n"
+                "}\n"
+                "return pow(a, b);"),
+    "rtl_inverse_sqrt": ("float rtl_inverse_sqrt(float a)", "return (a > 0.0) ? {inversesqrt}(a) : 0.0;"),
+    "rtl_log2": ("float rtl_log2(float a)", "return (a > 0.0) ? log2(a) : 0.0;"),
+    # atan2 with IEEE's signed zeros (C's atan2f, numpy): GLSL leaves atan(0, 0) undefined (llvmpipe
+    # gives 3 pi / 4) and Mesa's atan is off by 2e-5 relative (measured), so it is computed here: the
+    # octant reduction, then atan(t) for |t| <= tan(pi / 8) by the minimax polynomial of Moshier's Cephes
+    # ``atanf`` (coefficients as published; relative error ~2e-7 in float32)
+    "rtl_atan2": ("float rtl_atan2(float y, float x)",
+                  "float ax = abs(x), ay = abs(y);\n"
+                  "float hi = max(ax, ay), lo = min(ax, ay);\n"
+                  "float t = (hi > 0.0) ? lo / hi : 0.0;\n"
+                  "float base = 0.0;\n"
+                  "if (t > 0.41421356237) { t = (t - 1.0) / (t + 1.0); base = 0.78539816340; }\n"
+                  "float z = t * t;\n"
+                  "float r = base + ((((0.0805374449538 * z - 0.138776856032) * z + 0.199777106478) * z\n"
+                  "                   - 0.333329491539) * z * t + t);\n"
+                  "if (ay > ax) r = 1.57079632679 - r;\n"
+                  "if ({sign_bit}(x)) r = 3.14159265359 - r;\n"
+                  "return {sign_bit}(y) ? -r : r;"),
+    # acos / asin of the clamped input through rtl_atan2 (Mesa's acos / asin are off by 1e-4 / 4e-4, measured)
+    "rtl_acos": ("float rtl_acos(float a)",
+                 "float c = clamp(a, -1.0, 1.0);\nreturn rtl_atan2(sqrt((1.0 - c) * (1.0 + c)), c);"),
+    "rtl_asin": ("float rtl_asin(float a)",
+                 "float c = clamp(a, -1.0, 1.0);\nreturn rtl_atan2(c, sqrt((1.0 - c) * (1.0 + c)));"),
+    "rtl_normalize": ("{vec3} rtl_normalize({vec3} v)",
+                      "float n = length(v);\nreturn (n > 0.0) ? v / n : {vec3}(0.0, 0.0, 0.0);"),
+    # texel (floor(t n) clamped to [0, n - 1]; NaN reads texel 0): ``texel_index`` above
+    "rtl_texel_index": ("int rtl_texel_index(float t, int n)",
+                        "float x = floor(t * float(n));\n"
+                        "if (isnan(x)) x = 0.0;\n"
+                        "return int(clamp(x, 0.0, float(n - 1)));"),
 }
 
 #: Operations whose arguments are none (graph leaves).

@@ -91,6 +91,26 @@ def test_register_unregister_in_process(bpy_module, empty_scene):
     assert bpy_module.utils.user_resource('EXTENSIONS').startswith(os.environ["BLENDER_USER_RESOURCES"])
 
 
+@pytest.mark.blender
+def test_an_unsupported_blender_is_refused_with_the_supported_releases(bpy_module, monkeypatch):
+    """On a Blender older than the manifest's minimum, register() raises a message naming the supported
+    releases and registers nothing (instead of failing later on a missing API)."""
+    import tomllib
+
+    import rt_lookdev
+    from rt_lookdev.addon import compat
+
+    manifest = tomllib.loads((REPO_ROOT / "blender_manifest.toml").read_text())
+    assert tuple(int(x) for x in manifest["blender_version_min"].split(".")) == compat.MINIMUM_VERSION
+    before = set(dir(bpy_module.types))
+    monkeypatch.setattr(compat, "version", lambda: (4, 2, 23))
+    with pytest.raises(RuntimeError, match=r"needs Blender 4\.5\.0 or newer .*4\.5 LTS.*this is 4\.2\.23"):
+        rt_lookdev.register()
+    assert set(dir(bpy_module.types)) == before
+    monkeypatch.undo()
+    assert compat.supported()             # the release under test is a supported one
+
+
 class _RecordingLayout:
     """Stands in for bpy.types.UILayout (which cannot be created headless); records calls."""
 

@@ -78,9 +78,8 @@ def factory(bpy_module, empty_scene):
 
 def _new_material(bpy, name):
     """A new material with the default Principled BSDF -> Material Output tree."""
-    mat = bpy.data.materials.new(name)
-    if mat.node_tree is None:  # Blender < 5.0 (use_nodes is deprecated in 5.0)
-        mat.use_nodes = True
+    from rt_lookdev.addon import compat
+    mat = compat.new_material(name)
     return mat
 
 

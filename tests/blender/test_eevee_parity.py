@@ -40,13 +40,14 @@ def _ramp():
 
 
 def _build_scene(bpy, scene):
+    from rt_lookdev.addon import compat
     img = bpy.data.images.new("RTL_parity_ramp", RAMP, RAMP, alpha=True, float_buffer=True, is_data=True)
     img.alpha_mode = "CHANNEL_PACKED"
     img.colorspace_settings.name = "Non-Color"
     img.use_half_precision = False
     img.pixels.foreach_set(_ramp().ravel())       # img.pixels row 0 = bottom = v 0
 
-    mat = bpy.data.materials.new("RTL_parity")
+    mat = compat.new_material("RTL_parity")
     nt = mat.node_tree
     nt.nodes.clear()
     new, link = nt.nodes.new, nt.links.new
@@ -116,7 +117,7 @@ def _build_scene(bpy, scene):
     scene.collection.objects.link(cam)
     scene.camera = cam
 
-    world = bpy.data.worlds.new("RTL_parity_world")
+    world = compat.new_world("RTL_parity_world")
     world.color = (0.0, 0.0, 0.0)
     scene.world = world
 

@@ -55,6 +55,7 @@ DELTA_RTOL = 2e-4
 # --- scene -------------------------------------------------------------------------------------
 
 def _scene(bpy, samples, ortho_scale, center):
+    from rt_lookdev.addon import compat
     from rt_lookdev.validation.render_setup import configure_cycles_measurement
 
     bpy.ops.wm.read_homefile(use_empty=True)
@@ -75,7 +76,7 @@ def _scene(bpy, samples, ortho_scale, center):
     me.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
     plane = bpy.data.objects.new("RTL_plane", me)
     sc.collection.objects.link(plane)
-    mat = bpy.data.materials.new("RTL_white")
+    mat = compat.new_material("RTL_white")
     nt = mat.node_tree
     nt.nodes.clear()
     bsdf = nt.nodes.new("ShaderNodeBsdfDiffuse")

@@ -105,3 +105,31 @@ def test_node_counts_are_reported():
     counts = {name: node_count(trace(fn, dict.fromkeys(names, "float"))[1]) for name, (fn, names) in TECHNIQUES.items()}
     assert all(c > 0 for c in counts.values())
     assert counts["disney_sheen"] <= 6 and counts["ggx_brdf"] < 60
+
+
+def test_power_nodes_have_positive_constant_bases():
+    """Every Power node of every traced function has a positive constant base: Power(0, negative)
+    differs between Blender releases (addon/compat.py), and no shading code can reach it."""
+    from rt_lookdev.core.ir.expr import topological_order
+    from rt_lookdev.core.materials import rt_lit
+    from rt_lookdev.core.materials.rt_lit_interface import LIGHT_KINDS, Features
+    from rt_lookdev.node_groups import library
+
+    roots = [fn.function for fn in library.all_functions()]
+    roots += [rt_lit.build_rt_lit(Features(s, d, sheen=True, cloth=True), LIGHT_KINDS).function
+              for s in ("single", "turquin", "fdez_aguera", "kulla_conty") for d in ("lambert", "cod", "wrapped")]
+    seen, powers = set(), []
+    stack = list(roots)
+    while stack:
+        fn = stack.pop()
+        if fn.key in seen:
+            continue
+        seen.add(fn.key)
+        for node in topological_order(list(fn.outputs.values())):
+            if node.op == "power":
+                powers.append((fn.name, node.args[0]))
+            elif node.op == "call":
+                stack.append(node.graph.functions[node.attr("function")])
+    assert powers, "no Power node found: the walk is broken"
+    bad = [name for name, base in powers if not (base.is_const and base.attr("value") > 0.0)]
+    assert not bad, bad

@@ -1,0 +1,28 @@
+"""The main job's report (validation/main_job.py) is written from real step results: every section, with
+the render steps skipped and with them present."""
+from rt_lookdev.core.lut import catalog
+from rt_lookdev.validation import main_job
+
+
+def test_report_is_written_from_the_steps(tmp_path, monkeypatch):
+    monkeypatch.setattr(main_job, "LTC_LIGHTS", (6, 3))        # a small seeded light set: the same code path
+    quiet = lambda *a: None                                     # noqa: E731
+    job = {"date": "today", "seconds": 1.0,
+           "luts": main_job.step_luts(catalog.default_lut_dir(), quiet),
+           "numpy_checks": main_job.step_numpy_checks(catalog.default_lut_dir(), quiet),
+           "ltc": main_job.step_ltc(catalog.default_lut_dir(), quiet),
+           "render": None, "demo": None, "validation": None, "world_validation": None}
+    job["passed"] = main_job._passed(job)
+    main_job.write_report(job, tmp_path / "skipped")
+    text = (tmp_path / "skipped" / "report.md").read_text()
+    assert text.count("Skipped (--skip-render).") == 4 and "## LTC area lights" in text
+    assert (tmp_path / "skipped" / "report.json").stat().st_size > 0
+    job["render"] = {"settings": {"resolution_per_sphere": 8, "samples": 4, "seeds": [0, 1], "z_max": 5.0,
+                                  "sys_tol": 5e-4, "ms_tol": 0.005}, "summary_markdown": "RENDER TABLE",
+                     "passed": True}
+    for step in ("demo", "validation", "world_validation"):
+        job[step] = {"summary_markdown": f"{step.upper()} TABLE", "passed": True}
+    main_job.write_report(job, tmp_path / "full")
+    text = (tmp_path / "full" / "report.md").read_text()
+    assert all(f"{s} TABLE" in text for s in ("RENDER", "DEMO", "VALIDATION", "WORLD_VALIDATION"))
+    assert "Skipped" not in text
