@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import engines
+from . import engines, grids
 
 
 LAST_RENDER_SECONDS = [0.0]
@@ -238,17 +238,12 @@ def render_group_outputs(ng, inputs, output_name, engine="CYCLES"):
 
 RTOL = 1e-4
 ATOL = 1e-6
-NEAR_ZERO = 1e-2
+NEAR_ZERO = grids.NEAR_ZERO
 
 
 def compare(got, ref):
     """(max relative error where |ref| >= NEAR_ZERO, max absolute error elsewhere)."""
-    got, ref = np.asarray(got, np.float64), np.asarray(ref, np.float64)
-    err = np.abs(got - ref)
-    big = np.abs(ref) >= NEAR_ZERO
-    rel = float((err[big] / np.abs(ref[big])).max()) if big.any() else 0.0
-    absolute = float(err[~big].max()) if (~big).any() else 0.0
-    return rel, absolute
+    return grids.max_deviation(got, ref, NEAR_ZERO)
 
 
 def check_function(function, values, tables=None, rtol=RTOL, atol=ATOL):

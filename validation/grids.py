@@ -3,7 +3,9 @@
 No bpy here: ``ir_operation_graph`` with ``ir_operation_inputs`` (every IR operation once, on a grid with
 exact zeros, +-1e-7, integers, zero vectors and out-of-domain values), ``TECHNIQUES`` with ``technique_inputs`` (every technique's function and its argument grid,
 with zeros, 1e-7 and the domain's edges), ``punctual_lobe_inputs`` and ``area_lobe_inputs`` (the lobes'
-per-texel inputs: edge cases, grazing and below-horizon views, lights below, in the plane of, or tiny).
+per-texel inputs: edge cases, grazing and below-horizon views, lights below, in the plane of, or tiny),
+``shade_inputs`` (one light on the material), ``surface_inputs`` (the RT Lit surface), ``world_inputs`` and
+``random_environment`` (the World term's functions).
 """
 from __future__ import annotations
 
@@ -14,6 +16,19 @@ from ..core.conventions import alpha_from_roughness
 
 #: Side of the square per-texel grids (one render pixel per texel).
 SIZE = 48
+#: Below this |reference|, backends are compared by absolute error (relative above).
+NEAR_ZERO = 1e-2
+
+
+def max_deviation(got, ref, near_zero=NEAR_ZERO):
+    """How far a backend's values are from a reference: (max relative error where |ref| >= near_zero,
+    max absolute error elsewhere); 0 for an empty part."""
+    got, ref = np.asarray(got, np.float64), np.asarray(ref, np.float64)
+    err = np.abs(got - ref)
+    big = np.abs(ref) >= near_zero
+    rel = float((err[big] / np.abs(ref[big])).max()) if big.any() else 0.0
+    absolute = float(err[~big].max()) if (~big).any() else 0.0
+    return rel, absolute
 
 
 def unit_vectors(rng, shape, special=()):
@@ -164,3 +179,171 @@ def ir_operation_graph():
     if missing:
         raise AssertionError(f"operations not covered: {sorted(missing)}")
     return outputs
+
+
+def technique_function_inputs(seed=12, size=SIZE):
+    """Per-texel inputs of the stand-alone technique node functions (multiple-scattering scales, falloffs)."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    vals = {"F0": rng.random(shape + (3,)), "E": rng.uniform(0.0, 1.0, shape), "N.V": rng.random(shape),
+            "Roughness": rng.random(shape), "Distance": rng.uniform(0.0, 3.0, shape),
+            "Radius": rng.uniform(-0.5, 3.0, shape), "Cos To Axis": rng.uniform(-1, 1, shape),
+            "Inner Angle": rng.uniform(0, 3, shape), "Outer Angle": rng.uniform(0, 3, shape),
+            "Diameter": rng.uniform(0, 2, shape)}
+    vals["E"].reshape(-1)[:3] = [0.0, 1.0, 1e-3]
+    return {k: np.asarray(v, np.float32) for k, v in vals.items()}
+
+
+def shade_inputs(kind, seed=9, size=SIZE):
+    """Per-texel inputs of ``RTL Shade <kind>``: the area-lobe geometry plus random colours, weights, light
+    radiance / irradiance and a unit light direction L."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    vals = dict(area_lobe_inputs("disk" if kind == "disk" else "quad", size=size))
+    vals.update({"F0": rng.random(shape + (3,)), "Albedo": rng.random(shape + (3,)),
+                 "Sheen Color": rng.random(shape + (3,)), "Cloth Color": rng.random(shape + (3,)),
+                 "Cloth Weight": rng.random(shape), "Radiance": rng.random(shape + (3,)) * 10,
+                 "Irradiance": rng.random(shape + (3,)) * 10, "L": unit_vectors(rng, shape)})
+    return {k: np.asarray(v, np.float32) for k, v in vals.items()}
+
+
+def surface_inputs(names, seed=2, size=SIZE):
+    """Per-texel inputs of "RTL Surface" (``names``: its input sockets, name -> Socket): factors beyond
+    [0, 1], IOR below 1, unnormalised vectors, and a zero Normal in the first row (the geometry's)."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    vals = {}
+    for name, sock in names.items():
+        vals[name] = rng.uniform(-0.2, 1.2, shape) if sock.kind == "float" else rng.normal(size=shape + (3,))
+    vals["IOR"] = rng.uniform(0.5, 3.0, shape)
+    vals["Normal"][:8] = 0.0
+    return {k: np.asarray(v, np.float32) for k, v in vals.items()}
+
+
+#: Roughness of the levels of ``random_environment``.
+ENVIRONMENT_LEVELS = tuple(k / 8.0 for k in range(9))
+
+
+def random_environment(seed=11, height=16, width=32):
+    """A prefiltered-environment table of random radiance (9 levels of height x width, alpha 1): (L H, W, 4)."""
+    rng = np.random.default_rng(seed)
+    table = rng.uniform(0.05, 4.0, size=(len(ENVIRONMENT_LEVELS) * height, width, 4)).astype(np.float32)
+    table[..., 3] = 1.0
+    return table
+
+
+def smooth_environment(height=16, width=32):
+    """A prefiltered-environment table that varies slowly with direction (as real prefiltered levels do):
+    (L H, W, 4), rows in Blender order (row 0 at the bottom), alpha 1.  Unlike ``random_environment``, a
+    one-ulp difference in the direction-to-texel mapping (arccosine, atan2) moves its lookups by about
+    one ulp, not by the contrast between two random texels."""
+    from ..core.environment import equirect
+
+    d = equirect.texel_directions(height, width)                       # top row first
+    levels = [np.stack([1.5 + d[..., 0] * (1.0 - k / 10), 1.2 + 0.5 * d[..., 2], 1.0 + 0.3 * d[..., 1]], -1)
+              for k in range(len(ENVIRONMENT_LEVELS))]
+    table = np.concatenate([np.flipud(lv) for lv in levels], 0)
+    return np.concatenate([table, np.ones(table.shape[:2] + (1,))], -1).astype(np.float32)
+
+
+def world_inputs(seed=5, size=SIZE):
+    """Per-texel inputs of every World-term function: directions over the whole sphere with the poles and
+    the equirect seam, roughness 0 and 1 and between levels, V below the horizon, rotations, SH."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    z = [0.0, 0.0, 1.0]
+    n = unit_vectors(rng, shape, special=[z, [0, 0, -1], [-1, 1e-7, 0], [-1, -1e-7, 0], z, z, [1, 0, 0], z])
+    v = unit_vectors(rng, shape, special=[z, z, z, z, [1, 0, 0], [0, 0.6, -0.8], z, [0.6, 0, 0.8]])
+    flip = np.einsum("...i,...i->...", n, v) < 0
+    v[flip & (rng.random(shape) < 0.8)] *= -1
+    r = rng.random(shape).astype(np.float32)
+    r.reshape(-1)[:8] = [0.0, 1.0, 0.125, 0.5, 1e-3, 0.999, 0.0, 1.0]
+    vals = {"N": n, "V": v, "Direction": unit_vectors(rng, shape, special=[z, [0, 0, -1], [-1, 1e-7, 0],
+                                                                             [-1, -1e-7, 0]]),
+            "Axis": unit_vectors(rng, shape), "Roughness": r,
+            "Lambda 1": rng.uniform(0.3, 0.7, shape), "Lambda 2": rng.uniform(0.0, 0.25, shape),
+            "Rotation": rng.uniform(-3.5, 3.5, shape + (3,)),
+            "F0": rng.random(shape + (3,)), "Scale": rng.uniform(0.0, 1.0, shape),
+            "Bias": rng.uniform(0.0, 0.2, shape), "Prefiltered": rng.random(shape + (3,)) * 5,
+            "Irradiance": rng.random(shape + (3,)) * 5,
+            "Dielectric F0": rng.uniform(0.0, 0.1, shape + (3,)), "Metal F0": rng.random(shape + (3,)),
+            "Metallic": rng.random(shape), "Albedo": rng.random(shape + (3,)), "Wrap": rng.random(shape),
+            "Sheen Color": rng.random(shape + (3,)), "Cloth Weight": rng.random(shape),
+            "Cloth Color": rng.random(shape + (3,)), "World Strength": rng.uniform(0.1, 3.0, shape),
+            "World Rotation": rng.uniform(-3.5, 3.5, shape + (3,))}
+    vals["Scale"] = vals["Scale"] * (1.0 - vals["Bias"])
+    coeffs = rng.normal(size=(9, 3))
+    coeffs[0] += 4.0
+    for i in range(9):
+        vals[f"SH {i}"] = np.broadcast_to(coeffs[i], shape + (3,)).copy()
+        vals[f"World SH {i}"] = vals[f"SH {i}"]
+    return {k: np.asarray(a, np.float32) for k, a in vals.items()}
+
+
+def ltc_integral_inputs(ltc_table, size=SIZE, seed=13):
+    """Per-texel inputs of the LTC integral functions: the packed inverse matrix (c0..c3) of random texels
+    of ``ltc_table`` (an (H, W, 4) LTC matrix table), the light relative to the shading point (the
+    area-lobe grids' quads and disks), one- and two-sided."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    h, w = ltc_table.shape[:2]
+    texels = ltc_table[rng.integers(0, h, shape), rng.integers(0, w, shape)]
+    vals = {f"c{i}": texels[..., i] for i in range(4)}
+    quad, disk = area_lobe_inputs("quad", size=size), area_lobe_inputs("disk", size=size)
+    vals.update({f"p{i}": quad[f"p{i}"] - quad["Position"] for i in range(4)})
+    vals.update({"Center": disk["Center"] - disk["Position"], "Axis U": disk["Axis U"], "Axis V": disk["Axis V"],
+                 "Two Sided": (rng.random(shape) < 0.3).astype(np.float32)})
+    return {k: np.asarray(v, np.float32) for k, v in vals.items()}
+
+
+def light_data_inputs(function, size=SIZE, seed=17):
+    """Per-texel driver values of a light-data function (core/lights.py): locations, unit and non-unit
+    quaternions, negative and zero scales, powers, colours, sizes (zero included), cone angles, positions."""
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    vals = {}
+    for name in function.input_sockets:
+        if name == "Position":
+            vals[name] = rng.normal(size=shape + (3,)) * 2.0
+        elif name.startswith("Location"):
+            vals[name] = rng.normal(size=shape) * 3.0
+        elif name.startswith("Rotation"):
+            vals[name] = rng.normal(size=shape)
+        elif name.startswith("Scale"):
+            vals[name] = rng.uniform(-2.0, 2.0, shape)
+        elif name == "Spot Size":
+            vals[name] = rng.uniform(0.0, np.pi, shape)
+        elif name in ("Spot Blend",) or name.startswith("Color"):
+            vals[name] = rng.random(shape)
+        else:                                  # Power, Strength, Size, Size Y
+            vals[name] = rng.uniform(0.0, 5.0, shape) * (100.0 if name == "Power" else 1.0)
+        if name in ("Size", "Size Y", "Power", "Scale X"):
+            vals[name].reshape(-1)[:2] = 0.0
+    return {k: np.asarray(v, np.float32) for k, v in vals.items()}
+
+
+def material_inputs(material, size=SIZE, seed=21):
+    """Per-texel inputs of a whole RT Lit material (``core.materials.rt_lit.RtLitMaterial``): surface
+    inputs, points on the unit sphere seen from outside, every light's driver values, the world's."""
+    from ..core import lights
+
+    rng = np.random.default_rng(seed)
+    shape = (size, size)
+    vals = surface_inputs({n: s for n, s in material.function.sockets[0].items() if n in material.material_inputs},
+                          size=size, seed=seed)
+    n = unit_vectors(rng, shape)
+    vals.update({"Position": n, "Geometry Normal": n + rng.normal(size=shape + (3,)) * 0.01,
+                 "Incoming": unit_vectors(rng, shape)})
+    flip = np.einsum("...i,...i->...", n, vals["Incoming"]) < 0
+    vals["Incoming"][flip & (rng.random(shape) < 0.9)] *= -1
+    for kind, names in zip(material.light_kinds, material.light_inputs):
+        drivers = light_data_inputs(lights.LIGHT_DATA[kind], size=size, seed=int(rng.integers(1 << 30)))
+        for param, name in names.items():
+            value = drivers[param]
+            if param.startswith("Location"):          # lights outside the unit sphere
+                value = value + np.float32(3.0) * np.sign(value)
+            vals[name] = value
+    world = world_inputs(size=size, seed=int(rng.integers(1 << 30)))
+    for param, name in material.world_inputs.items():
+        vals[name] = world[name] if name in world else world[param]
+    return {k: np.asarray(v, np.float32) for k, v in vals.items()}

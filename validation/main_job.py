@@ -13,13 +13,17 @@ Steps (each prints what it does):
 4. Cycles render check: spheres under a white world (scripts/validate_energy.py).
 5. Demo lookdev scene (scripts/build_demo_scene.py, scripts/demo_report.py): RT Lit spheres under a
    quad and a disk light, saved to <out>/demo/lookdev_demo.blend; node counts, Cycles render time,
-   one EEVEE render compared with Cycles.
-6. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
+   one EEVEE render compared with Cycles; the scene exported (<out>/demo/realtime_scene) and drawn by
+   the GLSL backend's standalone renderer, compared with Cycles.
+6. Real-time backend, quick benchmark (scripts/benchmark_realtime.py --quick): frame time of the
+   emitted material on this machine's OpenGL, into <out>/benchmarks/realtime.md (the full table,
+   1080p, is docs/benchmarks/realtime.md).
+7. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
    brute-force integrals, per technique, with an HTML report in <out>/validation/.
-7. World validation (scripts/validate_world.py): the RT Lit World term under Blender's studio HDRIs
+8. World validation (scripts/validate_world.py): the RT Lit World term under Blender's studio HDRIs
    (Lambert vs Cycles Diffuse, SH-LTC CoD vs brute force, specular vs Cycles Glossy over a roughness
    sweep, the white furnace, node render vs numpy, bake times), report in <out>/validation_world/.
-8. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
+9. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
 """
 from __future__ import annotations
 
@@ -51,7 +55,7 @@ LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main jo
 
 
 def step_luts(lut_dir, log=report.flush_log):
-    log(f"[1/8] LUTs in {lut_dir}")
+    log(f"[1/9] LUTs in {lut_dir}")
 
     def progress(group, done, total):
         if done == total or done % max(1, total // 4) == 0:
@@ -65,7 +69,7 @@ def step_luts(lut_dir, log=report.flush_log):
 
 
 def step_numpy_checks(lut_dir, log=report.flush_log):
-    log("[2/8] numpy energy checks")
+    log("[2/9] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -96,12 +100,29 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
 
 
 def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
-    log("[5/8] demo lookdev scene: build, node counts, Cycles and EEVEE renders")
+    log("[5/9] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
     from . import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
-    result["summary_markdown"] = demo_report.format_markdown(result)
+    result["summary_markdown"] = demo_report.format_markdown(result, image_prefix="demo/")
     return result
+
+
+def step_realtime_benchmark(out_dir, log=report.flush_log):
+    log("[6/9] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
+    from . import glsl_runner, realtime_benchmark
+
+    glsl_runner.disable_shader_cache()
+    ok, why = glsl_runner.available()
+    if not ok:
+        log(f"      skipped: {why}")
+        return {"available": why, "passed": True, "summary_markdown": f"Not run: {why}."}
+    args = realtime_benchmark.parse_args(["--quick", "--out", str(out_dir / "benchmarks" / "realtime.md")])
+    result = realtime_benchmark.run(args, log=lambda line: log("      " + line))
+    finite = all(r["finite"] for r in result["rows"] if not r.get("gpu"))
+    text = realtime_benchmark.format_markdown(result).split("\n", 2)[2]        # without the title
+    return {"rows": result["rows"], "passed": finite, "summary_markdown": text + "\nFull table (1920 x 1080, 1/4/16 "
+            "lights): docs/benchmarks/realtime.md (`python scripts/benchmark_realtime.py`)."}
 
 
 def _run_suite(module, folder, lut_dir, log):
@@ -115,7 +136,7 @@ def _run_suite(module, folder, lut_dir, log):
 
 
 def step_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[6/8] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
+    log("[7/9] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
     from . import suite
 
     result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
@@ -124,7 +145,7 @@ def step_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_world_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[7/8] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
+    log("[8/9] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
     from . import world_suite
 
     result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
@@ -134,7 +155,7 @@ def step_world_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
-    log("[4/8] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
+    log("[4/9] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
     from . import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -145,7 +166,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
 
 
 def step_ltc(lut_dir, log=report.flush_log):
-    log("[3/8] LTC area lights: random quads and disks vs brute force")
+    log("[3/9] LTC area lights: random quads and disks vs brute force")
     from . import ltc_benchmark as benchmark_ltc
 
     t0 = time.perf_counter()
@@ -207,6 +228,9 @@ def write_report(job, out_dir):
     demo = job.get("demo")
     lines += ["## Demo lookdev scene (RT Lit materials)", ""]
     lines += [demo["summary_markdown"], ""] if demo else ["Skipped (--skip-render).", ""]
+    bench = job.get("realtime_benchmark")
+    lines += ["## Real-time backend: frame time (quick)", ""]
+    lines += [bench["summary_markdown"], ""] if bench else ["Skipped.", ""]
     val = job.get("validation")
     lines += ["## Validation suite (node render, numpy, Cycles ground truth)", ""]
     lines += [val["summary_markdown"], ""] if val else ["Skipped (--skip-render).", ""]
@@ -232,8 +256,8 @@ def parse_args(argv):
 def _passed(job):
     """Every step passed (a skipped render step, None, counts as passed)."""
     return bool(job["luts"]["passed"] and job["numpy_checks"]["passed"] and job["ltc"]["passed"]
-                and all(job[k] is None or job[k].get("passed", False)
-                        for k in ("render", "demo", "validation", "world_validation")))
+                and all(job.get(k) is None or job[k].get("passed", False)
+                        for k in ("render", "demo", "realtime_benchmark", "validation", "world_validation")))
 
 
 def run(args, log=report.flush_log):
@@ -252,11 +276,13 @@ def run(args, log=report.flush_log):
     if not args.skip_render:
         job["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
         job["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+    job["realtime_benchmark"] = step_realtime_benchmark(args.out, log)
+    if not args.skip_render:
         job["validation"] = step_validation(args.out, args.lut_dir, log)
         job["world_validation"] = step_world_validation(args.out, args.lut_dir, log)
     job["passed"] = _passed(job)
     job["seconds"] = time.perf_counter() - t0
-    log("[8/8] report")
+    log("[9/9] report")
     write_report(job, args.out)
     log((args.out / "report.md").read_text())
     log(f"report written to {args.out / 'report.md'} and report.json")

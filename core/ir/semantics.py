@@ -272,9 +272,15 @@ OPERATIONS = {
     "vsubtract": _op((V, V), V, np.subtract, "a - b", "({0} - {1})"),
     "vscale": _op((V, F), V, lambda v, s: v * np.asarray(s)[..., None], "v * s", "({0} * {1})"),
     "vmultiply": _op((V, V), V, np.multiply, "component-wise a * b", "({0} * {1})"),
-    "dot": _op((V, V), F, dot, "a . b", "dot({0}, {1})"),
-    "cross": _op((V, V), V, cross, "a x b", "cross({0}, {1})"),
-    "length": _op((V,), F, length, "|v|", "length({0})"),
+    # written out in numpy's order ((x + y) + z), not the language's dot(): llvmpipe's dot() fuses
+    # multiply-adds and differs from numpy by up to 6e-6 relative where the sum cancels; this form is
+    # bit-identical there (measured; docs/realtime.md, "Semantics")
+    "dot": _op((V, V), F, dot, "a . b ((a.x b.x + a.y b.y) + a.z b.z)",
+               "({0}.x * {1}.x + {0}.y * {1}.y + {0}.z * {1}.z)"),
+    "cross": _op((V, V), V, cross, "a x b (written out, as dot)",
+                 "{vec3}({0}.y * {1}.z - {0}.z * {1}.y, {0}.z * {1}.x - {0}.x * {1}.z, {0}.x * {1}.y - {0}.y * {1}.x)"),
+    "length": _op((V,), F, length, "|v| (sqrt of the written-out dot)",
+                  "sqrt({0}.x * {0}.x + {0}.y * {0}.y + {0}.z * {0}.z)"),
     "normalize": _op((V,), V, normalize, "v / |v|; the zero vector for |v| == 0", "rtl_normalize({0})"),
 }
 
@@ -317,7 +323,8 @@ SHADER_HELPERS = {
     "rtl_asin": ("float rtl_asin(float a)",
                  "float c = clamp(a, -1.0, 1.0);\nreturn rtl_atan2(c, sqrt((1.0 - c) * (1.0 + c)));"),
     "rtl_normalize": ("{vec3} rtl_normalize({vec3} v)",
-                      "float n = length(v);\nreturn (n > 0.0) ? v / n : {vec3}(0.0, 0.0, 0.0);"),
+                      "float n = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);\n"
+                      "return (n > 0.0) ? v / n : {vec3}(0.0, 0.0, 0.0);"),
     # texel (floor(t n) clamped to [0, n - 1]; NaN reads texel 0): ``texel_index`` above
     "rtl_texel_index": ("int rtl_texel_index(float t, int n)",
                         "float x = floor(t * float(n));\n"

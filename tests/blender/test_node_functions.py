@@ -7,13 +7,11 @@ import pytest
 from rt_lookdev.validation.conformance import check_function
 from rt_lookdev.validation.grids import area_lobe_inputs as _area_inputs
 from rt_lookdev.validation.grids import punctual_lobe_inputs as _punctual_inputs
-from rt_lookdev.validation.grids import unit_vectors
+from rt_lookdev.validation.grids import shade_inputs, surface_inputs, technique_function_inputs
 
 pytest.importorskip("OpenEXR")
 
 pytestmark = pytest.mark.blender
-
-SIZE = 48
 
 
 @pytest.mark.parametrize("lobe", ["ggx", "kulla_conty", "lambert", "cod", "wrapped", "cloth", "sheen"])
@@ -83,16 +81,7 @@ def test_shade_groups_match_numpy(empty_scene, tables, kind):
     from rt_lookdev.core.materials import light_shading
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
-    rng = np.random.default_rng(9)
-    base = _area_inputs("quad" if kind != "disk" else "disk")
-    shape = (SIZE, SIZE)
-    vals = dict(base)
-    vals.update({"F0": rng.random(shape + (3,)), "Albedo": rng.random(shape + (3,)),
-                 "Sheen Color": rng.random(shape + (3,)), "Cloth Color": rng.random(shape + (3,)),
-                 "Cloth Weight": rng.random(shape), "Radiance": rng.random(shape + (3,)) * 10,
-                 "Irradiance": rng.random(shape + (3,)) * 10})
-    l = base["Position"] * 0 + unit_vectors(rng, shape)
-    vals["L"] = l
+    vals = shade_inputs(kind)
     for features in (Features("kulla_conty", "wrapped", sheen=True, cloth=True), Features("turquin", "cod")):
         fn = light_shading.shade_function(kind, features)
         check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, tables)
@@ -101,16 +90,7 @@ def test_shade_groups_match_numpy(empty_scene, tables, kind):
 def test_surface_group_matches_numpy(empty_scene, tables):
     from rt_lookdev.core.materials.surface import SURFACE
 
-    rng = np.random.default_rng(2)
-    shape = (SIZE, SIZE)
-    vals = {}
-    for name, sock in SURFACE.input_sockets.items():
-        if sock.kind == "float":
-            vals[name] = rng.uniform(-0.2, 1.2, shape)
-        else:
-            vals[name] = rng.normal(size=shape + (3,))
-    vals["IOR"] = rng.uniform(0.5, 3.0, shape)
-    vals["Normal"][:8] = 0.0                        # unlinked normal: the geometry's
+    vals = surface_inputs(SURFACE.input_sockets)
     check_function(SURFACE, {k: np.asarray(v, np.float32) for k, v in vals.items()}, tables)
 
 
@@ -129,14 +109,7 @@ def test_every_catalog_group_builds_small_and_the_technique_groups_match_numpy(e
     assert all(fn.name in bpy.data.node_groups for fn in library.all_functions())
     assert max(counts.values()) <= MAX_GROUP_NODES, max(counts.items(), key=lambda kv: kv[1])
     assert all(bpy.data.node_groups[fn.name].description for fn in library.all_functions())
-    rng = np.random.default_rng(12)
-    shape = (SIZE, SIZE)
-    vals = {"F0": rng.random(shape + (3,)), "E": rng.uniform(0.0, 1.0, shape), "N.V": rng.random(shape),
-            "Roughness": rng.random(shape), "Distance": rng.uniform(0.0, 3.0, shape),
-            "Radius": rng.uniform(-0.5, 3.0, shape), "Cos To Axis": rng.uniform(-1, 1, shape),
-            "Inner Angle": rng.uniform(0, 3, shape), "Outer Angle": rng.uniform(0, 3, shape),
-            "Diameter": rng.uniform(0, 2, shape)}
-    vals["E"].reshape(-1)[:3] = [0.0, 1.0, 1e-3]
+    vals = technique_function_inputs()
     for fn in multiscatter.NODE_FUNCTIONS + falloff.NODE_FUNCTIONS:
         check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, tables)
     # the operator builds the same set, reusing what exists

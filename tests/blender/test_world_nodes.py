@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 
 from rt_lookdev.validation.conformance import check_function
-from rt_lookdev.validation.grids import unit_vectors
+from rt_lookdev.validation.grids import ENVIRONMENT_LEVELS as LEVELS
+from rt_lookdev.validation.grids import random_environment, smooth_environment, world_inputs
 
 pytest.importorskip("OpenEXR")
 
 pytestmark = pytest.mark.blender
 
 SIZE = 48
-LEVELS = tuple(k / 8.0 for k in range(9))
 
 
 @pytest.fixture(scope="module")
@@ -27,49 +27,14 @@ def environment(tmp_path_factory):
     from rt_lookdev.core.lut import exr_io
     from rt_lookdev.core.materials import world_shading as world
 
-    rng = np.random.default_rng(11)
-    h, w = 16, 32
-    table = rng.uniform(0.05, 4.0, size=(len(LEVELS) * h, w, 4)).astype(np.float32)
-    table[..., 3] = 1.0
+    table = random_environment()
     path = tmp_path_factory.mktemp("env") / "env_test_ggx_prefiltered.exr"
     exr_io.write_table(path, table, {"table": "env_test", "roughness_levels": "[" + ", ".join(map(str, LEVELS)) + "]"})
     return world.WorldEnvironment.load(path, "env_test_conformance"), path
 
 
-def _inputs(seed=5):
-    rng = np.random.default_rng(seed)
-    shape = (SIZE, SIZE)
-    z = [0.0, 0.0, 1.0]
-    n = unit_vectors(rng, shape, special=[z, [0, 0, -1], [-1, 1e-7, 0], [-1, -1e-7, 0], z, z, [1, 0, 0], z])
-    v = unit_vectors(rng, shape, special=[z, z, z, z, [1, 0, 0], [0, 0.6, -0.8], z, [0.6, 0, 0.8]])
-    flip = np.einsum("...i,...i->...", n, v) < 0
-    v[flip & (rng.random(shape) < 0.8)] *= -1
-    r = rng.random(shape).astype(np.float32)
-    r.reshape(-1)[:8] = [0.0, 1.0, 0.125, 0.5, 1e-3, 0.999, 0.0, 1.0]
-    vals = {"N": n, "V": v, "Direction": unit_vectors(rng, shape, special=[z, [0, 0, -1], [-1, 1e-7, 0],
-                                                                             [-1, -1e-7, 0]]),
-            "Axis": unit_vectors(rng, shape), "Roughness": r,
-            "Lambda 1": rng.uniform(0.3, 0.7, shape), "Lambda 2": rng.uniform(0.0, 0.25, shape),
-            "Rotation": rng.uniform(-3.5, 3.5, shape + (3,)),
-            "F0": rng.random(shape + (3,)), "Scale": rng.uniform(0.0, 1.0, shape),
-            "Bias": rng.uniform(0.0, 0.2, shape), "Prefiltered": rng.random(shape + (3,)) * 5,
-            "Irradiance": rng.random(shape + (3,)) * 5,
-            "Dielectric F0": rng.uniform(0.0, 0.1, shape + (3,)), "Metal F0": rng.random(shape + (3,)),
-            "Metallic": rng.random(shape), "Albedo": rng.random(shape + (3,)), "Wrap": rng.random(shape),
-            "Sheen Color": rng.random(shape + (3,)), "Cloth Weight": rng.random(shape),
-            "Cloth Color": rng.random(shape + (3,)), "World Strength": rng.uniform(0.1, 3.0, shape),
-            "World Rotation": rng.uniform(-3.5, 3.5, shape + (3,))}
-    vals["Scale"] = vals["Scale"] * (1.0 - vals["Bias"])
-    coeffs = rng.normal(size=(9, 3))
-    coeffs[0] += 4.0
-    for i in range(9):
-        vals[f"SH {i}"] = np.broadcast_to(coeffs[i], shape + (3,)).copy()
-        vals[f"World SH {i}"] = vals[f"SH {i}"]
-    return vals
-
-
 def _check(fn, tables):
-    vals = _inputs()
+    vals = world_inputs()
     return check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, tables)
 
 
@@ -118,23 +83,17 @@ def test_shade_world_computes_the_same_in_eevee(empty_scene, tables, tmp_path):
     from rt_lookdev.validation.conformance import render_group_outputs
 
     from rt_lookdev.addon import node_emit
-    from rt_lookdev.core.environment import equirect
     from rt_lookdev.core.lut import exr_io
     from rt_lookdev.core.materials import world_shading as world
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
-    h, w = 16, 32
-    d = equirect.texel_directions(h, w)                       # top row first
-    levels = [np.stack([1.5 + d[..., 0] * (1.0 - k / 10), 1.2 + 0.5 * d[..., 2], 1.0 + 0.3 * d[..., 1]], -1)
-              for k in range(len(LEVELS))]
-    table = np.concatenate([np.flipud(lv) for lv in levels], 0)
-    table = np.concatenate([table, np.ones(table.shape[:2] + (1,))], -1).astype(np.float32)
+    table = smooth_environment()
     path = tmp_path / "env_smooth.exr"
     exr_io.write_table(path, table, {"table": "env_smooth", "roughness_levels": str(list(LEVELS))})
     env = world.WorldEnvironment.load(path, "env_smooth_eevee")
     tables = tables.with_tables(env.as_table())
     fn = world.shade_world_function(Features("fdez_aguera", "cod", sheen=True, cloth=True), env)
-    vals = _inputs()
+    vals = world_inputs()
     vals = {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}
     ng = node_emit.ensure_function_group(fn, tables)
     cycles = render_group_outputs(ng, vals, "Radiance")

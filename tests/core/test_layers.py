@@ -1,7 +1,7 @@
 """The architecture's rules, read from the source (docs/architecture.md, "Layers"):
 
 - imports go downwards only: core/ir < shading_ops, conventions < core/lut < core techniques <
-  core/materials < node_groups < addon < validation (scripts/ and tests/ sit on top);
+  core/materials < core/export < node_groups < addon < validation (scripts/ and tests/ sit on top);
 - no module of core/ imports bpy (or any other Blender module);
 - no sys.path edits in scripts/ or tests/ (the package is installed in editable mode: pyproject.toml);
 - every file name is used once in the tree;
@@ -25,10 +25,11 @@ LAYERS = (
     ("core ops", 1, lambda m: m in ("core.shading_ops", "core.conventions")),
     ("core.lut", 2, lambda m: m == "core.lut" or m.startswith("core.lut.")),
     ("core.materials", 4, lambda m: m == "core.materials" or m.startswith("core.materials.")),
+    ("core.export", 5, lambda m: m == "core.export" or m.startswith("core.export.")),
     ("core techniques", 3, lambda m: m == "core" or m.startswith("core.")),
-    ("node_groups", 5, lambda m: m.split(".")[0] == "node_groups"),
-    ("addon", 6, lambda m: m.split(".")[0] == "addon"),
-    ("validation", 7, lambda m: m.split(".")[0] == "validation"),
+    ("node_groups", 6, lambda m: m.split(".")[0] == "node_groups"),
+    ("addon", 7, lambda m: m.split(".")[0] == "addon"),
+    ("validation", 8, lambda m: m.split(".")[0] == "validation"),
 )
 
 

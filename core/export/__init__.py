@@ -1,0 +1,1 @@
+"""Exports for engines and standalone renderers (no bpy): the scene description (``scene``)."""

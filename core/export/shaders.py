@@ -1,0 +1,123 @@
+"""Write an RT Lit material's shaders for an engine: the fragment and vertex shader in each dialect, the
+uniform interface as JSON, and the tables the shader samples.
+
+    write_material_shaders(folder, material, dialects=("glsl450", "glsl300es", "hlsl"), luts=None)
+
+``folder`` gets ``rt_lit.<dialect>.frag`` / ``.vert`` (``.ps.hlsl`` / ``.vs.hlsl`` for HLSL),
+``interface.json`` (the uniforms in declaration order with their types and meanings, the light slots,
+and per table its texture uniform, size and file) and, when ``luts`` (a LUT folder) is given, the LUT
+files the material reads (the world's prefiltered table too, when the material has one).  Written to a
+temporary sibling folder and renamed into place, like the scene export.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+from ..lut import catalog
+from ..materials import rt_lit_shader
+
+EXTENSIONS = {"glsl450": ("glsl450.frag", "glsl450.vert"), "glsl300es": ("glsl300es.frag", "glsl300es.vert"),
+              "hlsl": ("ps.hlsl", "vs.hlsl")}
+
+
+def interface(shader):
+    """The uniform interface of a ``MaterialShader`` as plain data."""
+    return {"material": shader.material.name, "features": shader.material.features.as_dict(),
+            "light_slots": [{"kind": kind, "uniform": f"{rt_lit_shader.light_array(kind)}[{index}]",
+                             "struct": rt_lit_shader.LIGHT_STRUCTS[kind],
+                             "fields": [{"field": f, "type": t, "parameters": [p for p, _ in parts]}
+                                        for f, t, parts in rt_lit_shader.light_fields(kind)]}
+                            for kind, index in shader.light_slots],
+            "uniforms": [{"name": u.name, "type": u.type, "meaning": u.meaning} for u in shader.uniforms],
+            "tables": {name: {"uniform": texture, "height": h, "width": w, "format": "RGBA32F",
+                              "rows": "texel row j covers v in [j/H, (j + 1)/H): upload the EXR's last scanline as row 0", "read": "exact texel fetches (no sampler state)"}
+                       for name, (texture, h, w) in shader.tables.items()},
+            "output": "frag_radiance: RGB outgoing radiance towards the camera (scene-linear), alpha 1"}
+
+
+def write_material_shaders(folder, material, dialects=tuple(EXTENSIONS), luts=None, precise=True):
+    """Write ``material`` (``rt_lit.RtLitMaterial``) into ``folder``; returns the files written (names)."""
+    unknown = [d for d in dialects if d not in EXTENSIONS]
+    if unknown:
+        raise ValueError(f"unknown dialects {unknown}; choose from {sorted(EXTENSIONS)}")
+    folder = Path(folder)
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.partial-", dir=folder.parent))
+    written = []
+    try:
+        shaders = {}
+        for dialect in dialects:
+            shader = rt_lit_shader.material_shader(material, dialect, precise)
+            shaders[dialect] = shader
+            frag, vert = EXTENSIONS[dialect]
+            (tmp / f"rt_lit.{frag}").write_text(shader.fragment)
+            (tmp / f"rt_lit.{vert}").write_text(shader.vertex)
+            written += [f"rt_lit.{frag}", f"rt_lit.{vert}"]
+        first = next(iter(shaders.values()))
+        data = interface(first)
+        if luts is not None:
+            for name, entry in data["tables"].items():
+                if name in catalog.TABLES:
+                    source = Path(luts) / catalog.TABLES[name].filename
+                elif material.environment is not None and name == material.environment.name \
+                        and material.environment.source is not None:
+                    source = Path(material.environment.source)
+                else:
+                    raise ValueError(f"table {name!r} has no file to copy (an environment without its EXR)")
+                if not source.is_file():
+                    raise FileNotFoundError(f"table {name!r}: {source} does not exist (bake the LUTs first)")
+                shutil.copyfile(source, tmp / source.name)
+                entry["file"] = source.name
+                written.append(source.name)
+        (tmp / "interface.json").write_text(json.dumps(data, indent=1))
+        written.append("interface.json")
+        if folder.exists():
+            shutil.rmtree(folder)
+        tmp.rename(folder)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return written
+
+
+def parse_args(argv):
+    """The options of scripts/export_shader.py."""
+    from ..materials.rt_lit_interface import DIFFUSE_MODELS, LIGHT_KINDS, SPECULAR_MODELS
+
+    p = argparse.ArgumentParser(description="Write the RT Lit material's shaders, interface and tables for an engine")
+    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--specular", default="turquin", choices=SPECULAR_MODELS)
+    p.add_argument("--diffuse", default="cod", choices=DIFFUSE_MODELS)
+    p.add_argument("--sheen", action="store_true")
+    p.add_argument("--cloth", action="store_true")
+    p.add_argument("--lights", default="quad,disk", help=f"light kinds in order, from {', '.join(LIGHT_KINDS)}")
+    p.add_argument("--dialects", default=",".join(EXTENSIONS))
+    p.add_argument("--world", type=Path, default=None, help="a prefiltered environment EXR (a world bake)")
+    p.add_argument("--world-table", default=None, help="its table name (default: the file's stem)")
+    p.add_argument("--no-precise", action="store_true", help="let the compiler fuse and reorder arithmetic")
+    p.add_argument("--lut-dir", type=Path, default=None)
+    return p.parse_args(argv)
+
+
+def run_args(args, log=print):
+    """scripts/export_shader.py: build the material the options name and write it; the exit code."""
+    from ..materials import rt_lit
+    from ..materials.rt_lit_interface import LIGHT_KINDS, Features
+    from ..materials.world_shading import WorldEnvironment
+
+    kinds = tuple(k for k in args.lights.split(",") if k)
+    bad = [k for k in kinds if k not in LIGHT_KINDS]
+    if bad:
+        print(f"export_shader: unknown light kinds {bad}; choose from {', '.join(LIGHT_KINDS)}", file=sys.stderr)
+        return 2
+    env = WorldEnvironment.load(args.world, args.world_table or args.world.stem) if args.world else None
+    material = rt_lit.build_rt_lit(Features(args.specular, args.diffuse, args.sheen, args.cloth), kinds, env)
+    written = write_material_shaders(args.out, material, tuple(args.dialects.split(",")),
+                                     args.lut_dir or catalog.default_lut_dir(), not args.no_precise)
+    log(f"{material.name}: wrote {len(written)} files to {args.out}: {', '.join(written)}")
+    return 0

@@ -1,0 +1,144 @@
+"""Every emitted shader compiles with glslang's reference compiler: each technique, every node group
+offered to artists and the World-term functions (each with a probe entry point), and the whole RT Lit
+material for several feature sets and light lists (fragment and vertex shader), in GLSL 4.50, GLSL ES
+3.00 and HLSL.  A refused shader fails with glslang's log and the source lines it names."""
+from __future__ import annotations
+
+import pytest
+
+from rt_lookdev.core.ir import shader_text, trace
+from rt_lookdev.core.ir.expr import Function
+from rt_lookdev.validation import glslang
+from rt_lookdev.validation.grids import TECHNIQUES
+
+pytestmark = pytest.mark.glsl
+
+DIALECTS = ("glsl450", "glsl300es", "hlsl")
+
+
+def _compile_function(fn, dialect):
+    module = shader_text.emit(fn, dialect)
+    glslang.compile_source(shader_text.probe_entry(module), "frag", dialect)
+    return module
+
+
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_every_technique_compiles(glslang_path, dialect):
+    for name, (fn, names) in sorted(TECHNIQUES.items()):
+        _, out = trace(fn, dict.fromkeys(names, "float"))
+        _compile_function(Function(f"RTL {name}", dict.fromkeys(names, "float"), {"out": out}), dialect)
+
+
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_every_library_function_compiles(glslang_path, dialect):
+    from rt_lookdev.core.materials import world_shading as world
+    from rt_lookdev.node_groups import library
+
+    functions = list(library.all_functions()) + [world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD,
+                                                 world.SH_LTC_CLOTH, world.SH_LTC_SHEEN]
+    for fn in functions:
+        module = _compile_function(fn, dialect)
+        # readable output: one function per node function, named after it, with its description
+        assert f"// {fn.name}" in module.source
+        assert module.entry.ident.startswith("rtl_")
+
+
+MATERIALS = {
+    "all features, every light kind, world": (dict(specular="kulla_conty", diffuse="wrapped", sheen=True, cloth=True),
+                                              ("quad", "disk", "point", "spot", "sun"), True),
+    "demo: turquin + CoD, quad and disk, world": (dict(specular="turquin", diffuse="cod"), ("quad", "disk"), True),
+    "fdez-aguera (radiance form), two suns and a spot": (dict(specular="fdez_aguera", diffuse="lambert",
+                                                              environment_ms="radiance"), ("sun", "sun", "spot"), True),
+    "minimal: single + Lambert, one point, no world": (dict(specular="single", diffuse="lambert"), ("point",), False),
+    "no lights, world only": (dict(specular="turquin", diffuse="cod", sheen=True), (), True),
+}
+
+
+@pytest.fixture(scope="module")
+def environment(tmp_path_factory):
+    from rt_lookdev.core.lut import exr_io
+    from rt_lookdev.core.materials import world_shading as world
+    from rt_lookdev.validation import grids
+
+    path = tmp_path_factory.mktemp("env") / "env_compile.exr"
+    exr_io.write_table(path, grids.smooth_environment(), {"table": "env_compile",
+                                                          "roughness_levels": str(list(grids.ENVIRONMENT_LEVELS))})
+    return world.WorldEnvironment.load(path, "env_compile")
+
+
+@pytest.mark.parametrize("dialect", DIALECTS)
+@pytest.mark.parametrize("case", sorted(MATERIALS))
+def test_material_shader_compiles(glslang_path, environment, dialect, case):
+    from rt_lookdev.core.materials import rt_lit, rt_lit_shader
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    features, kinds, world = MATERIALS[case]
+    material = rt_lit.build_rt_lit(Features(**features), kinds, environment if world else None)
+    shader = rt_lit_shader.material_shader(material, dialect)
+    glslang.compile_source(shader.fragment, "frag", dialect)
+    glslang.compile_source(shader.vertex, "vert", dialect)
+    # the interface names every input the material function takes, and nothing is left unbound
+    assert set(shader.bindings) >= {n for n, _ in material.function.inputs}
+    for kind in set(kinds):
+        assert f"u_{kind}_lights[{kinds.count(kind)}]" in shader.fragment
+    assert ("u_world_sh[9]" in shader.fragment) == world
+    # papers named in the comments of the functions they implement
+    if features.get("specular") == "kulla_conty":
+        assert "Kulla" in shader.fragment
+    if "quad" in kinds:
+        assert "Heitz" in shader.fragment
+
+
+def test_a_refused_shader_names_its_line(glslang_path):
+    source = "#version 450 core\nlayout(location = 0) out vec4 o;\nvoid main()\n{\n    o = vec4(undefined_name);\n}\n"
+    with pytest.raises(glslang.GlslangError) as err:
+        glslang.compile_source(source, "frag", "glsl450")
+    message = str(err.value)
+    assert "undefined_name" in message and "    5      o = vec4(undefined_name);" in message
+
+
+def test_export_shader_script_writes_what_compiles(glslang_path, tmp_path, lut_dir):
+    """scripts/export_shader.py: shaders in every dialect, interface.json and the LUT files they sample."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location("export_shader", Path(__file__).parents[2] / "scripts" / "export_shader.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    out = tmp_path / "shaders"
+    assert script.main(["--out", str(out), "--lights", "quad,sun", "--specular", "kulla_conty", "--cloth",
+                        "--lut-dir", str(lut_dir)]) == 0
+    data = json.loads((out / "interface.json").read_text())
+    assert [s["uniform"] for s in data["light_slots"]] == ["u_quad_lights[0]", "u_sun_lights[0]"]
+    for name, entry in data["tables"].items():
+        assert (out / entry["file"]).is_file(), name
+    for dialect, (frag, vert) in {"glsl450": ("glsl450.frag", "glsl450.vert"),
+                                  "glsl300es": ("glsl300es.frag", "glsl300es.vert"),
+                                  "hlsl": ("ps.hlsl", "vs.hlsl")}.items():
+        glslang.compile_source((out / f"rt_lit.{frag}").read_text(), "frag", dialect)
+        glslang.compile_source((out / f"rt_lit.{vert}").read_text(), "vert", dialect)
+    assert script.main(["--out", str(tmp_path / "bad"), "--lights", "tube"]) == 2
+    assert not (tmp_path / "bad").exists()
+
+
+def test_docs_show_the_interface_the_code_emits(tmp_path):
+    """docs/realtime.md's uniform table is the one rt_lit_shader.interface_markdown writes for the
+    reference material (a world table of the bake's size named env_0123456789ab)."""
+    from pathlib import Path
+
+    from rt_lookdev.core.lut import exr_io
+    from rt_lookdev.core.materials import rt_lit_shader
+    from rt_lookdev.core.materials import world_shading as world
+    from rt_lookdev.validation import grids
+
+    path = tmp_path / "env.exr"
+    exr_io.write_table(path, grids.smooth_environment(64, 128), {"table": "env_0123456789ab",
+                                                                "roughness_levels": str(list(grids.ENVIRONMENT_LEVELS))})
+    env = world.WorldEnvironment.load(path, "env_0123456789ab")
+    table = rt_lit_shader.interface_markdown(rt_lit_shader.material_shader(rt_lit_shader.reference_material(env)))
+    doc = (Path(__file__).parents[2] / "docs" / "realtime.md").read_text()
+    begin, end = "<!-- interface:begin -->\n", "<!-- interface:end -->"
+    assert doc[doc.index(begin) + len(begin):doc.index(end)].strip() == table.strip(), (
+        "docs/realtime.md's interface table is out of date; paste rt_lit_shader.interface_markdown(...) between "
+        "the interface markers:\n" + table)
