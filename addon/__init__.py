@@ -2,18 +2,22 @@
 
 Everything that touches ``bpy`` lives here; the numeric work is in ``..core``.  Each
 submodule defines its classes, and this module registers them in one ``classes``
-tuple (in order) and unregisters them in reverse.  Registration does no file I/O.
+tuple (in order), then appends the ``menus`` entries; unregistering does both in reverse.
+Registration does no file I/O.
 """
 import bpy
 
-from . import compat, convert, operators, preferences, ui
+from . import compat, convert, export_operators, operators, preferences, ui
 
 classes = (
     *operators.classes,
+    *export_operators.classes,
     *convert.classes,
     *preferences.classes,
     *ui.classes,
 )
+#: (menu, draw function): entries appended to Blender's menus (File > Export).
+menus = (*export_operators.menus,)
 
 
 def register():
@@ -23,9 +27,13 @@ def register():
         raise RuntimeError(compat.unsupported_message())
     for cls in classes:
         bpy.utils.register_class(cls)
+    for menu, draw in menus:
+        menu.append(draw)
 
 
 def unregister():
+    for menu, draw in reversed(menus):
+        menu.remove(draw)
     for cls in reversed(classes):
         bpy.utils.unregister_class(cls)
     preferences.clear_status_cache()

@@ -10,20 +10,22 @@ Steps (each prints what it does):
    E_avg polynomial.
 3. LTC area lights (numpy): end-to-end error of the LTC tables on seeded random quads and
    disks against brute-force integrals (a smaller set than scripts/benchmark_ltc.py).
-4. Cycles render check: spheres under a white world (scripts/validate_energy.py).
-5. Demo lookdev scene (scripts/build_demo_scene.py, scripts/demo_report.py): RT Lit spheres under a
+4. LUT export for engines (scripts/export_luts.py): every format and precision in both layouts into
+   <out>/export/rtl and <out>/export/ltc_code, read back against the source tables.
+5. Cycles render check: spheres under a white world (scripts/validate_energy.py).
+6. Demo lookdev scene (scripts/build_demo_scene.py, scripts/demo_report.py): RT Lit spheres under a
    quad and a disk light, saved to <out>/demo/lookdev_demo.blend; node counts, Cycles render time,
    one EEVEE render compared with Cycles; the scene exported (<out>/demo/realtime_scene) and drawn by
    the GLSL backend's standalone renderer, compared with Cycles.
-6. Real-time backend, quick benchmark (scripts/benchmark_realtime.py --quick): frame time of the
+7. Real-time backend, quick benchmark (scripts/benchmark_realtime.py --quick): frame time of the
    emitted material on this machine's OpenGL, into <out>/benchmarks/realtime.md (the full table,
    1080p, is docs/benchmarks/realtime.md).
-7. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
+8. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
    brute-force integrals, per technique, with an HTML report in <out>/validation/.
-8. World validation (scripts/validate_world.py): the RT Lit World term under Blender's studio HDRIs
+9. World validation (scripts/validate_world.py): the RT Lit World term under Blender's studio HDRIs
    (Lambert vs Cycles Diffuse, SH-LTC CoD vs brute force, specular vs Cycles Glossy over a roughness
    sweep, the white furnace, node render vs numpy, bake times), report in <out>/validation_world/.
-9. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
+10. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
 """
 from __future__ import annotations
 
@@ -55,7 +57,7 @@ LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main jo
 
 
 def step_luts(lut_dir, log=report.flush_log):
-    log(f"[1/9] LUTs in {lut_dir}")
+    log(f"[1/10] LUTs in {lut_dir}")
 
     def progress(group, done, total):
         if done == total or done % max(1, total // 4) == 0:
@@ -69,7 +71,7 @@ def step_luts(lut_dir, log=report.flush_log):
 
 
 def step_numpy_checks(lut_dir, log=report.flush_log):
-    log("[2/9] numpy energy checks")
+    log("[2/10] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -100,7 +102,7 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
 
 
 def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
-    log("[5/9] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
+    log("[6/10] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
     from . import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
@@ -108,8 +110,38 @@ def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
     return result
 
 
+def step_lut_export(out_dir, lut_dir, log=report.flush_log):
+    log("[4/10] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
+    from ..core.export import luts as lut_export
+
+    t0 = time.perf_counter()
+    out = {"layouts": {}}
+    lines = ["| layout | folder | files | size | read back |", "|---|---|---|---|---|"]
+    for layout in lut_export.LAYOUTS:
+        folder = out_dir / "export" / layout
+        result = lut_export.export(folder, lut_dir, layout=layout)
+        check = lut_export.verify(folder, lut_dir)
+        exact = all(r["max_abs"] == 0.0 for f, r in check.items() if "_f32" in f)
+        bounded = all(r["within_bound"] for r in check.values())
+        out["layouts"][layout] = {"folder": str(folder), "files": result.files, "read_back": check,
+                                  "f32_exact": exact, "f16_within_rounding": bounded}
+        lines.append(f"| {layout} | `{folder}` | {len(result.files)} | {sum(result.files.values()) / 1e6:.2f} MB | "
+                     f"{len(check)} tables read back: f32 {'exact' if exact else '**differs**'}, f16 "
+                     f"{'within half rounding' if bounded else '**beyond half rounding**'} |")
+        log(f"      {layout}: {len(result.files)} files, {sum(result.files.values()) / 1e6:.2f} MB, read back "
+            f"{'ok' if exact and bounded else 'FAILED'}")
+    files = out["layouts"]["rtl"]["files"]
+    lines += ["", "Files of the rtl layout (bytes):", "", "| file | size |", "|---|---|"]
+    lines += [f"| {name} | {size} |" for name, size in sorted(files.items())]
+    out["passed"] = all(v["f32_exact"] and v["f16_within_rounding"] for v in out["layouts"].values())
+    out["seconds"] = round(time.perf_counter() - t0, 1)
+    out["summary_markdown"] = "\n".join(lines) + ("\n\nManifest: `export/<layout>/manifest.json`; half precision per "
+                                                   "table and end to end: docs/benchmarks/lut_export.md.")
+    return out
+
+
 def step_realtime_benchmark(out_dir, log=report.flush_log):
-    log("[6/9] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
+    log("[7/10] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
     from . import glsl_runner, realtime_benchmark
 
     glsl_runner.disable_shader_cache()
@@ -136,7 +168,7 @@ def _run_suite(module, folder, lut_dir, log):
 
 
 def step_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[7/9] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
+    log("[8/10] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
     from . import suite
 
     result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
@@ -145,7 +177,7 @@ def step_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_world_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[8/9] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
+    log("[9/10] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
     from . import world_suite
 
     result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
@@ -155,7 +187,7 @@ def step_world_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
-    log("[4/9] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
+    log("[5/10] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
     from . import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -166,7 +198,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
 
 
 def step_ltc(lut_dir, log=report.flush_log):
-    log("[3/9] LTC area lights: random quads and disks vs brute force")
+    log("[3/10] LTC area lights: random quads and disks vs brute force")
     from . import ltc_benchmark as benchmark_ltc
 
     t0 = time.perf_counter()
@@ -215,6 +247,9 @@ def write_report(job, out_dir):
         lines.append(f"| {key} | {o['lights_over_10pct']}/{o['lights']} | {100 * o['rel_median']:.2f}% | "
                      f"{100 * o['rel_p90']:.1f}% | {100 * o['abs_over_albedo_median']:.2f}% |")
     lines.append("")
+    export = job.get("lut_export")
+    lines += ["## LUT export for engines", ""]
+    lines += [export["summary_markdown"], ""] if export else ["Skipped.", ""]
     render = job.get("render")
     lines += ["## Cycles render check (spheres under a white world)", ""]
     if render is None:
@@ -257,7 +292,8 @@ def _passed(job):
     """Every step passed (a skipped render step, None, counts as passed)."""
     return bool(job["luts"]["passed"] and job["numpy_checks"]["passed"] and job["ltc"]["passed"]
                 and all(job.get(k) is None or job[k].get("passed", False)
-                        for k in ("render", "demo", "realtime_benchmark", "validation", "world_validation")))
+                        for k in ("lut_export", "render", "demo", "realtime_benchmark", "validation",
+                                  "world_validation")))
 
 
 def run(args, log=report.flush_log):
@@ -272,6 +308,7 @@ def run(args, log=report.flush_log):
         return job
     job["numpy_checks"] = step_numpy_checks(args.lut_dir, log)
     job["ltc"] = step_ltc(args.lut_dir, log)
+    job["lut_export"] = step_lut_export(args.out, args.lut_dir, log)
     job["render"] = job["demo"] = job["validation"] = job["world_validation"] = None
     if not args.skip_render:
         job["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
@@ -282,7 +319,7 @@ def run(args, log=report.flush_log):
         job["world_validation"] = step_world_validation(args.out, args.lut_dir, log)
     job["passed"] = _passed(job)
     job["seconds"] = time.perf_counter() - t0
-    log("[9/9] report")
+    log("[10/10] report")
     write_report(job, args.out)
     log((args.out / "report.md").read_text())
     log(f"report written to {args.out / 'report.md'} and report.json")

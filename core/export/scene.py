@@ -23,11 +23,12 @@ from __future__ import annotations
 
 import json
 import shutil
-import tempfile
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from .folders import replacing_folder
 
 FORMAT = "rt-lookdev-scene"
 VERSION = 1
@@ -275,13 +276,7 @@ def write(folder, description, geometry, table_files, log=None):
     key: (positions, normals)}) and ``table_files`` ({file name: source path}) into ``folder``, atomically:
     everything goes to a temporary sibling folder that replaces ``folder`` only when complete."""
     folder = Path(folder)
-    parent = folder.parent
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.partial-", dir=parent))
-    except OSError as exc:
-        raise SceneDescriptionError(f"cannot write the scene export into {parent}: {exc}") from None
-    try:
+    with replacing_folder(folder, SceneDescriptionError) as tmp:
         (tmp / TABLES_DIR).mkdir()
         for name, source in table_files.items():
             source = Path(source)
@@ -295,17 +290,6 @@ def write(folder, description, geometry, table_files, log=None):
         np.savez(tmp / GEOMETRY_FILE, **arrays)
         (tmp / SCENE_FILE).write_text(json.dumps(description.to_json(), indent=1, default=_json_value))
         read(tmp)                                   # what a reader will see: refuse to publish otherwise
-        if folder.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{folder.name}.old-", dir=parent))
-            old.rmdir()
-            folder.rename(old)
-            tmp.rename(folder)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            tmp.rename(folder)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     if log:
         log(f"scene export: {folder} ({len(description.objects)} objects, {len(description.lights)} lights, "
             f"{len(table_files)} tables)")

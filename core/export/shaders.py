@@ -15,11 +15,11 @@ import argparse
 import json
 import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 from ..lut import catalog
 from ..materials import rt_lit_shader
+from .folders import replacing_folder
 
 EXTENSIONS = {"glsl450": ("glsl450.frag", "glsl450.vert"), "glsl300es": ("glsl300es.frag", "glsl300es.vert"),
               "hlsl": ("ps.hlsl", "vs.hlsl")}
@@ -45,11 +45,8 @@ def write_material_shaders(folder, material, dialects=tuple(EXTENSIONS), luts=No
     unknown = [d for d in dialects if d not in EXTENSIONS]
     if unknown:
         raise ValueError(f"unknown dialects {unknown}; choose from {sorted(EXTENSIONS)}")
-    folder = Path(folder)
-    folder.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.partial-", dir=folder.parent))
     written = []
-    try:
+    with replacing_folder(folder) as tmp:
         shaders = {}
         for dialect in dialects:
             shader = rt_lit_shader.material_shader(material, dialect, precise)
@@ -76,12 +73,6 @@ def write_material_shaders(folder, material, dialects=tuple(EXTENSIONS), luts=No
                 written.append(source.name)
         (tmp / "interface.json").write_text(json.dumps(data, indent=1))
         written.append("interface.json")
-        if folder.exists():
-            shutil.rmtree(folder)
-        tmp.rename(folder)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return written
 
 

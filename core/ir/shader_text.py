@@ -281,6 +281,19 @@ def emit(function, dialect="glsl450", precise=True):
     return ShaderModule(d, em.module(entry), entry, {sf.name: sf for sf in em.functions.values()}, dict(em.tables))
 
 
+def emit_library(functions, dialect="glsl450", precise=True, title=None):
+    """Emit several traced functions (and everything they call) as one include file: no version or
+    precision header (the including shader has its own) and no entry point.  Returns a ShaderModule
+    whose ``entry`` is the last function given."""
+    d = DIALECTS[dialect] if isinstance(dialect, str) else dialect
+    em = _Emitter(d, precise)
+    entries = [em.function(getattr(f, "function", f)) for f in functions]
+    source = em.module(entries[-1])[len(d.header):]
+    if title:
+        source = f"// {title}\n" + source
+    return ShaderModule(d, source, entries[-1], {sf.name: sf for sf in em.functions.values()}, dict(em.tables))
+
+
 def kinds_glsl(kind, dialect):
     """The type of an IR kind in ``dialect`` ("float", "vec3"/"float3")."""
     d = DIALECTS[dialect] if isinstance(dialect, str) else dialect

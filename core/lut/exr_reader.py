@@ -3,7 +3,7 @@
 Blender's bundled Python has no ``OpenEXR`` module, so the add-on reads its tables with
 this when that import fails.  It supports exactly what ``exr_io.write_table`` produces and
 refuses anything else with a clear error: single-part scanline images, NO or ZIP(S)
-compression, FLOAT (32-bit) channels, x/y sampling 1.  Attributes of type string, int,
+compression, FLOAT (32-bit) or HALF (16-bit) channels (all of one type), x/y sampling 1.  Attributes of type string, int,
 float and double are decoded; others are kept as raw bytes.
 
 Format: OpenEXR file layout (openexr.com, "OpenEXR File Layout"): magic 20000630, version
@@ -22,7 +22,8 @@ import numpy as np
 MAGIC = 20000630
 _NO, _ZIPS, _ZIP = 0, 2, 3
 _LINES_PER_CHUNK = {_NO: 1, _ZIPS: 1, _ZIP: 16}
-_FLOAT = 2
+_HALF, _FLOAT = 1, 2
+_DTYPES = {_HALF: "<f2", _FLOAT: "<f4"}
 
 
 class ExrFormatError(ValueError):
@@ -100,9 +101,12 @@ def read(path):
     x0, y0, x1, y1 = attrs["dataWindow"]
     width, height = x1 - x0 + 1, y1 - y0 + 1
     channels = sorted(attrs["channels"])
+    types_used = {pixel_type for _, pixel_type, _, _ in channels}
     for name, pixel_type, xs, ys in channels:
-        if pixel_type != _FLOAT or xs != 1 or ys != 1:
-            raise ExrFormatError(f"channel {name}: only unsubsampled 32-bit float is supported")
+        if pixel_type not in _DTYPES or xs != 1 or ys != 1 or len(types_used) != 1:
+            raise ExrFormatError(f"channel {name}: only unsubsampled 32-bit or 16-bit float channels, all of one "
+                                 "type, are supported")
+    dtype = np.dtype(_DTYPES[types_used.pop()])
     lines = _LINES_PER_CHUNK[compression]
     n_chunks = (height + lines - 1) // lines
     offsets = struct.unpack_from(f"<{n_chunks}Q", data, pos)
@@ -111,12 +115,12 @@ def read(path):
         y, size = struct.unpack_from("<ii", data, offset)
         chunk = data[offset + 8:offset + 8 + size]
         rows = min(lines, y1 + 1 - y)
-        expected = rows * width * 4 * len(channels)
+        expected = rows * width * dtype.itemsize * len(channels)
         if compression != _NO and size < expected:
             chunk = _unzip(chunk, expected)
         if len(chunk) != expected:
             raise ExrFormatError(f"chunk at line {y}: {len(chunk)} bytes, expected {expected}")
-        block = np.frombuffer(chunk, dtype="<f4").reshape(rows, len(channels), width)
+        block = np.frombuffer(chunk, dtype=dtype).reshape(rows, len(channels), width)
         for c, (name, *_) in enumerate(channels):
             planes[name][y - y0:y - y0 + rows] = block[:, c]
     attrs["channels"] = [name for name, *_ in channels]

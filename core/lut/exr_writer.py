@@ -2,7 +2,8 @@
 
 Blender's bundled Python has no ``OpenEXR`` module, so ``exr_io.write_table`` writes with this
 when that import fails (baking a world's environment from inside Blender, for instance).  It
-writes one flavour only: a single-part scanline image, 32-bit FLOAT channels with x/y sampling 1,
+writes one flavour only: a single-part scanline image, 32-bit FLOAT (or 16-bit HALF, ``pixel_type="half"``)
+channels with x/y sampling 1,
 INCREASING_Y line order, NO, ZIPS or ZIP compression (ZIP by default, as ``write_table`` uses with
 the OpenEXR package).  Attributes: the required ones (channels, compression, dataWindow,
 displayWindow, lineOrder, pixelAspectRatio, screenWindowCenter, screenWindowWidth), ``type`` =
@@ -42,7 +43,7 @@ MAGIC = 20000630
 VERSION = 2
 LONG_NAMES = 0x400
 COMPRESSIONS = {"none": (0, 1), "zips": (2, 1), "zip": (3, 16)}   # name -> (code, lines per block)
-_FLOAT = 2
+_PIXEL_TYPES = {"half": (1, "<f2"), "float": (2, "<f4")}    # EXR pixel type code, numpy dtype
 _INT32 = (-2**31, 2**31 - 1)
 ZLIB_LEVEL = 6
 
@@ -79,23 +80,26 @@ def _reorder_predict(raw):
     return out.tobytes()
 
 
-def encode(planes, attributes=None, compression="zip"):
+def encode(planes, attributes=None, compression="zip", pixel_type="float"):
     """The bytes of an EXR file holding ``planes`` ({channel name: (H, W) array, top row first},
-    stored as float32) and ``attributes`` ({name: str | int | float})."""
+    stored as float32, or float16 with ``pixel_type="half"``) and ``attributes`` ({name: str | int | float})."""
+    if pixel_type not in _PIXEL_TYPES:
+        raise ExrWriteError(f"pixel type {pixel_type!r}: expected one of {sorted(_PIXEL_TYPES)}")
+    type_code, dtype = _PIXEL_TYPES[pixel_type]
     if compression not in COMPRESSIONS:
         raise ExrWriteError(f"compression {compression!r}: expected one of {sorted(COMPRESSIONS)}")
     code, lines = COMPRESSIONS[compression]
     if not planes:
         raise ExrWriteError("no channels")
     names = sorted(planes)
-    arrays = [np.asarray(planes[n], dtype="<f4") for n in names]
+    arrays = [np.asarray(planes[n], dtype=dtype) for n in names]
     shape = arrays[0].shape
     if len(shape) != 2 or shape[0] < 1 or shape[1] < 1 or any(a.shape != shape for a in arrays):
         raise ExrWriteError(f"channels must be non-empty 2D arrays of one shape, got "
                             f"{[a.shape for a in arrays]}")
     height, width = shape
     box = struct.pack("<4i", 0, 0, width - 1, height - 1)
-    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", _FLOAT, 0, 1, 1) for n in names) + b"\0"
+    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", type_code, 0, 1, 1) for n in names) + b"\0"
     header = {
         "channels": ("chlist", chlist),
         "compression": ("compression", bytes([code])),
@@ -140,8 +144,8 @@ def encode(planes, attributes=None, compression="zip"):
     return head + struct.pack(f"<{len(offsets)}Q", *offsets) + b"".join(blocks)
 
 
-def write(path, planes, attributes=None, compression="zip"):
-    """Write ``encode(planes, attributes, compression)`` to ``path`` (not atomically: callers that
-    need that write a temporary name and rename, as ``exr_io.write_table`` does)."""
-    data = encode(planes, attributes, compression)
+def write(path, planes, attributes=None, compression="zip", pixel_type="float"):
+    """Write ``encode(planes, attributes, compression, pixel_type)`` to ``path`` (not atomically: callers
+    that need that write a temporary name and rename, as ``exr_io.write_table`` does)."""
+    data = encode(planes, attributes, compression, pixel_type)
     Path(path).write_bytes(data)

@@ -11,7 +11,8 @@ from rt_lookdev.validation import extension_zip as build_extension
 from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
-OPERATORS = ["add_node_groups", "convert_to_principled", "convert_to_rt_lit", "lut_status", "sync_lights", "sync_world"]
+OPERATORS = ["add_node_groups", "convert_to_principled", "convert_to_rt_lit", "export_luts", "export_scene", "lut_status",
+             "sync_lights", "sync_world"]
 
 pytestmark = pytest.mark.blender
 

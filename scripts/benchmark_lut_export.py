@@ -1,0 +1,18 @@
+"""Half-precision LUTs measured per table and end to end (LTC light set, furnaces); writes
+docs/benchmarks/lut_export.{md,json}.
+
+    python scripts/benchmark_lut_export.py [--quads 120 --disks 60] [--out docs/benchmarks/lut_export.md]
+
+Entry point of ``rt_lookdev.validation.lut_export_benchmark``; ``--help`` lists the options."""
+import sys
+
+from rt_lookdev.validation import lut_export_benchmark
+
+
+def main(argv):
+    lut_export_benchmark.run(lut_export_benchmark.parse_args(argv))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
