@@ -43,13 +43,34 @@ def light_kind(obj):
     return {"POINT": "point", "SPOT": "spot", "SUN": "sun"}.get(data.type)
 
 
+def is_rendered(scene, obj):
+    """Whether a render of ``scene`` includes ``obj``: not disabled in renders (the object or a collection
+    holding it), and in a view layer that renders (a collection excluded from every rendering view layer
+    takes its objects out of them)."""
+    if obj.hide_render or any(c.hide_render for c in obj.users_collection):
+        return False
+    held = {c.name for c in obj.users_collection}
+    return any(layer.use and held & _included_collections(layer.layer_collection) for layer in scene.view_layers)
+
+
+def _included_collections(layer_collection, out=None):
+    """Names of the collections a view layer includes (an excluded layer collection drops its children);
+    read from the layer collections themselves, which do not wait for the view layer to resync."""
+    out = set() if out is None else out
+    if not layer_collection.exclude:
+        out.add(layer_collection.collection.name)
+        for child in layer_collection.children:
+            _included_collections(child, out)
+    return out
+
+
 def scene_lights(scene):
-    """(object, kind) of every light RT Lit shades: rendered lights, in name order (the sun
-    with angle 0, point and spot lights with radius 0: see core/lights.py)."""
+    """(object, kind) of every light RT Lit shades: rendered lights (``is_rendered``), in name order (the
+    sun with angle 0, point and spot lights with radius 0: see core/lights.py)."""
     out = []
     for obj in sorted(scene.objects, key=lambda o: o.name):
         kind = light_kind(obj)
-        if kind is not None and not obj.hide_render:
+        if kind is not None and is_rendered(scene, obj):
             out.append((obj, kind))
     return out
 

@@ -35,6 +35,16 @@ def cod_gloss_talk(smoothness, natural_log=False):
     return np.clip(0.18455 * log(np.maximum(x, 1e-300)), 0.0, 1.0)
 
 
+# Chan 2018 fits the retro-reflection amplitude with the quadratic (34.5 g - 59) g + 24.5, whose roots are
+# g = 0.710 and g = 1: between them it is negative (down to -0.72 at g = 0.855, i.e. r ~ 0.05-0.13), and
+# with light and view grazing from the same side (fd -> 0.0625, l.h -> 1, n.h -> 0) the BRDF itself went
+# negative (found by the robustness sweep, docs/robustness.md).  The fit reaches 0 at g = 1, so clamping it
+# at 0 keeps its shape where it is positive and only removes the overshoot.
+def retro_reflection_scale(g):
+    """max((34.5 g - 59) g + 24.5, 0): the CoD WWII retro-reflection amplitude, clamped at 0."""
+    return op.maximum((34.5 * g - 59.0) * g + 24.5, 0.0)
+
+
 def cod_multiscatter_diffuse(albedo, mu_l, mu_v, n_dot_h, l_dot_h, alpha):
     """Call of Duty WWII multiscattering diffuse BRDF (Chan 2018, course notes; the talk).
 
@@ -42,17 +52,18 @@ def cod_multiscatter_diffuse(albedo, mu_l, mu_v, n_dot_h, l_dot_h, alpha):
       f0 = (l.h) + (1 - l.h)^5                               rough limit
       f1 = (1 - 0.75 (1 - n.l)^5)(1 - 0.75 (1 - n.v)^5)     smooth limit
       fd = lerp(f0, f1, saturate(2.2 g - 0.5))
-      fb = ((34.5 g - 59) g + 24.5) (l.h) 2^(-max(73.2 g - 21.2, 8.9) sqrt(n.h))   retro-reflection
+      fb = max((34.5 g - 59) g + 24.5, 0) (l.h) 2^(-max(73.2 g - 21.2, 8.9) sqrt(n.h))   retro-reflection
     The 1/pi belongs to the BRDF (multiply by mu_l for radiance).  Symmetric in l and v
     (l.h = v.h), so reciprocal.  Zero below either horizon.
+
+    Deviation from the paper: the retro-reflection coefficient is clamped at 0 (``retro_reflection_scale``).
     """
     g = cod_gloss_from_alpha(alpha)
     ldh = op.saturate(l_dot_h)
     f0 = ldh + op.pow5(1.0 - ldh)
     f1 = (1.0 - 0.75 * op.pow5(1.0 - op.saturate(mu_l))) * (1.0 - 0.75 * op.pow5(1.0 - op.saturate(mu_v)))
     fd = op.mix(f0, f1, op.saturate(2.2 * g - 0.5))
-    fb = ((34.5 * g - 59.0) * g + 24.5) * ldh * op.exp2(
-        -op.maximum(73.2 * g - 21.2, 8.9) * op.sqrt(n_dot_h))
+    fb = retro_reflection_scale(g) * ldh * op.exp2(-op.maximum(73.2 * g - 21.2, 8.9) * op.sqrt(n_dot_h))
     above = op.logical_and(op.greater(mu_l, 0.0), op.greater(mu_v, 0.0))
     return op.select(above, albedo * (1.0 / np.pi) * (fd + fb), 0.0)
 

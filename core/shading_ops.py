@@ -106,16 +106,19 @@ def pow5(a):
     return a2 * a2 * a
 
 
+# min and max ignore a NaN operand (IEEE 754-2008 minNum / maxNum): Cycles' Math node computes them with
+# fminf / fmaxf and GPUs' min / max return the other operand, so clamp(NaN, 0, 1) = 0 in every backend and
+# a NaN material input (a texture, a driver) cannot reach a pixel through a clamped factor.
 def minimum(a, b):
     if is_expr(a, b):
         return _node("minimum", a, b)
-    return np.minimum(_arr(a), _arr(b))
+    return np.fmin(_arr(a), _arr(b))
 
 
 def maximum(a, b):
     if is_expr(a, b):
         return _node("maximum", a, b)
-    return np.maximum(_arr(a), _arr(b))
+    return np.fmax(_arr(a), _arr(b))
 
 
 def clamp(a, lo, hi):

@@ -57,7 +57,7 @@ LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main jo
 
 
 def step_luts(lut_dir, log=report.flush_log):
-    log(f"[1/10] LUTs in {lut_dir}")
+    log(f"[1/11] LUTs in {lut_dir}")
 
     def progress(group, done, total):
         if done == total or done % max(1, total // 4) == 0:
@@ -71,7 +71,7 @@ def step_luts(lut_dir, log=report.flush_log):
 
 
 def step_numpy_checks(lut_dir, log=report.flush_log):
-    log("[2/10] numpy energy checks")
+    log("[2/11] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -102,7 +102,7 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
 
 
 def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
-    log("[6/10] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
+    log("[6/11] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
     from . import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
@@ -111,7 +111,7 @@ def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
 
 
 def step_lut_export(out_dir, lut_dir, log=report.flush_log):
-    log("[4/10] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
+    log("[4/11] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
     from ..core.export import luts as lut_export
 
     t0 = time.perf_counter()
@@ -140,8 +140,32 @@ def step_lut_export(out_dir, lut_dir, log=report.flush_log):
     return out
 
 
+def step_robustness(out_dir, lut_dir, log=report.flush_log):
+    log("[10/11] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
+        "(scripts/robustness_sweep.py --points 2000)")
+    from . import robustness
+
+    out = out_dir / "benchmarks" / "robustness.md"
+    argv = ["--points", "2000", "--out", str(out)] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
+    result = robustness.run(robustness.parse_args(argv), log=lambda line: None)
+    rows = ["| backend | evaluations | NaN | Inf | negative | over bound |", "|---|---|---|---|---|---|"]
+    for backend, families in result["summary"].items():
+        total = {k: sum(f[k] for f in families.values()) for k in ("points", "nan", "inf", "negative", "over_bound")}
+        rows.append(f"| {backend} | {total['points']:,} | {total['nan']} | {total['inf']} | {total['negative']} | "
+                    f"{total['over_bound']} |")
+        log(f"      {backend}: {total['points']:,} evaluations, {total['nan'] + total['inf'] + total['negative'] + total['over_bound']} failures")
+    rows += [f"| {b} | not run: {why} | | | | |" for b, why in result["skipped"].items()]
+    text = "\n".join(rows) + (f"\n\nPer family: `{out}`; the full sweep (10^6 points per family and backend): "
+                              "docs/benchmarks/robustness.md (`python scripts/robustness_sweep.py`); method, "
+                              "findings and the bad-input table: docs/robustness.md.")
+    numpy_ok = all(f["nan"] + f["inf"] + f["negative"] + f["over_bound"] == 0
+                   for f in result["summary"].get("numpy float32", {}).values())
+    return {"failures": result["failures"], "summary": result["summary"], "skipped": result["skipped"],
+            "passed": numpy_ok, "summary_markdown": text}
+
+
 def step_realtime_benchmark(out_dir, log=report.flush_log):
-    log("[7/10] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
+    log("[7/11] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
     from . import glsl_runner, realtime_benchmark
 
     glsl_runner.disable_shader_cache()
@@ -168,7 +192,7 @@ def _run_suite(module, folder, lut_dir, log):
 
 
 def step_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[8/10] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
+    log("[8/11] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
     from . import suite
 
     result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
@@ -177,7 +201,7 @@ def step_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_world_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[9/10] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
+    log("[9/11] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
     from . import world_suite
 
     result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
@@ -187,7 +211,7 @@ def step_world_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
-    log("[5/10] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
+    log("[5/11] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
     from . import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -198,7 +222,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
 
 
 def step_ltc(lut_dir, log=report.flush_log):
-    log("[3/10] LTC area lights: random quads and disks vs brute force")
+    log("[3/11] LTC area lights: random quads and disks vs brute force")
     from . import ltc_benchmark as benchmark_ltc
 
     t0 = time.perf_counter()
@@ -272,6 +296,9 @@ def write_report(job, out_dir):
     world = job.get("world_validation")
     lines += ["## World validation (the World term under the studio HDRIs)", ""]
     lines += [world["summary_markdown"], ""] if world else ["Skipped (--skip-render).", ""]
+    robust = job.get("robustness")
+    lines += ["## Robustness (quick sweep)", ""]
+    lines += [robust["summary_markdown"], ""] if robust else ["Skipped.", ""]
     lines += [f"Overall: **{'PASS' if job['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
@@ -293,7 +320,7 @@ def _passed(job):
     return bool(job["luts"]["passed"] and job["numpy_checks"]["passed"] and job["ltc"]["passed"]
                 and all(job.get(k) is None or job[k].get("passed", False)
                         for k in ("lut_export", "render", "demo", "realtime_benchmark", "validation",
-                                  "world_validation")))
+                                  "world_validation", "robustness")))
 
 
 def run(args, log=report.flush_log):
@@ -317,9 +344,10 @@ def run(args, log=report.flush_log):
     if not args.skip_render:
         job["validation"] = step_validation(args.out, args.lut_dir, log)
         job["world_validation"] = step_world_validation(args.out, args.lut_dir, log)
+    job["robustness"] = step_robustness(args.out, args.lut_dir, log)
     job["passed"] = _passed(job)
     job["seconds"] = time.perf_counter() - t0
-    log("[10/10] report")
+    log("[11/11] report")
     write_report(job, args.out)
     log((args.out / "report.md").read_text())
     log(f"report written to {args.out / 'report.md'} and report.json")

@@ -102,9 +102,17 @@ def ggx_specular_multiscatter(tables, light, p, n, v, roughness, f0, method="tur
 
 
 # The talk, "LTCs for multiscattering diffuse": the CoD WWII lobe's own LTC (albedo 1 in the table).
+# Chan 2018's fit reflects more than it receives for rough surfaces seen at grazing angles (its directional
+# albedo, the table's magnitude, reaches 1.14 at r = 1, mu_v -> 0; docs/robustness.md), so the magnitude is
+# bounded by 1 (``albedo_bound``): a white CoD surface stays within the white furnace under any light.
+def albedo_bound(magnitude):
+    """min(magnitude, 1): a lobe's directional albedo, bounded by energy conservation."""
+    return op.minimum(magnitude, 1.0)
+
+
 def cod_diffuse(tables, light, p, n, v, roughness, albedo):
     value, magnitude, _ = lobe_integral(tables, "ltc_cod_diffuse", light, p, n, v, roughness)
-    return magnitude * value * albedo
+    return albedo_bound(magnitude) * value * albedo
 
 
 # The talk, "LTCs for Ashikhmin cloth": the cloth lobe's LTC (sheen colour 1 in the table).

@@ -83,9 +83,10 @@ LTC_FIT = {"size": LTC_SIZE, "moment_samples": 1 << 14, "fit_samples": [384, 384
            "max_iter": 300, "fit_mu_min": 1e-3}
 
 _LTC_SOURCES = ("core/ltc/fit.py", "core/ltc/fit_lobes.py", "core/ltc/matrix.py", "core/ltc/optimize.py",
-                "core/ltc/sphere_table.py", "core/microfacet.py", "core/diffuse.py", "core/cloth.py",
-                "core/sampling.py", "core/conventions.py", "core/shading_ops.py", "core/ir/semantics.py",
-                "core/lut_bake.py")
+                "core/ltc/sphere_table.py", "core/microfacet.py", "core/sampling.py", "core/conventions.py",
+                "core/shading_ops.py", "core/ir/semantics.py", "core/lut_bake.py")
+#: The module of each LTC lobe's BRDF beyond GGX (only its own group depends on it).
+_LTC_BRDF_SOURCES = {"ltc_cod_diffuse": ("core/diffuse.py",), "ltc_cloth": ("core/cloth.py",)}
 
 #: LTC lobes: table prefix -> (lobe name in core.ltc.fit_lobes, description)
 LTC_LOBES = {
@@ -96,7 +97,7 @@ LTC_LOBES = {
 
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
     GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=dict(LTC_FIT, lobe=_lobe),
-                                sources=_LTC_SOURCES)
+                                sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_prefix, ()))
 
 LTC_INV_CHANNELS = ("R = c0 = Minv_xx, G = c1 = Minv_zx, B = c2 = Minv_xz, A = c3 = Minv_zz "
                     "(Minv normalised so that Minv_yy = 1)")

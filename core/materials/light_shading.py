@@ -19,9 +19,10 @@ from . import lobes
 from .rt_lit_interface import GEOMETRY_INPUTS, SURFACE_OUTPUTS
 
 
-def combine_lobes(features, surface, lobe_values, light_color):
+def combine_lobes(features, surface, lobe_values, light_color, area=False):
     """Radiance towards the viewer from one light: the enabled lobes weighted by the material's
-    colours, times the light's colour (radiance or irradiance, per light kind)."""
+    colours, times the light's colour (radiance or irradiance, per light kind; ``area``: an area
+    light's, whose lobes are integrals over the light)."""
     f0 = surface["F0"]
     spec = op.scale(f0, lobe_values["Scale"]) + op.splat(lobe_values["Bias"])
     if features.specular == "turquin":
@@ -34,7 +35,14 @@ def combine_lobes(features, surface, lobe_values, light_color):
         # Kulla & Conty 2017: + F_ms(F_avg) f_ms
         om_avg = lobe_values["One Minus E Avg"]
         f_ms = op.per_channel(lambda c: multiscatter.kulla_conty_fresnel_factor(fresnel_average(c), om_avg), f0)
-        spec = spec + op.scale(f_ms, lobe_values["Lobe"])
+        lobe = lobe_values["Lobe"]
+        if area:
+            # Over an area light the single-scattering lobe's albedo is the LTC magnitude E, the multiple-
+            # scattering lobe's the energy table's 1 - E(mu_v): two fits that disagree at grazing views of
+            # near-mirrors (E_ltc ~ 0.99, E_table ~ 0.61 at mu_v -> 0, r -> 0), where their sum reached 1.39
+            # of the light (docs/robustness.md).  The lobe is bounded by what the first leaves, 1 - E_ltc.
+            lobe = op.minimum(lobe, op.maximum(1.0 - lobe_values["E"], 0.0))
+        spec = spec + op.scale(f_ms, lobe)
     if features.cloth:
         cloth = op.scale(surface["Cloth Color"], lobe_values["Cloth"])
         w = surface["Cloth Weight"]
@@ -80,7 +88,7 @@ def shade_function(kind, features):
         values = {}
         for fn in functions:
             values.update(fn(tables, **_arguments(fn, kw)))
-        return {"Radiance": combine_lobes(features, kw, values, kw[color_name])}
+        return {"Radiance": combine_lobes(features, kw, values, kw[color_name], kind in lobes.AREA_KINDS)}
 
     inputs = {k: SURFACE_OUTPUTS[k] for k in SHADE_SURFACE}
     if kind in lobes.AREA_KINDS + ("point", "spot"):

@@ -112,20 +112,26 @@ def _kulla_conty_punctual(tables, N, V, L, Roughness):
     return {"Lobe": op.select(above, lobe * mu_l, 0.0), "One Minus E Avg": om_avg}
 
 
+# Over a light, int_light f_ms mu_i dw = (1 - E(mu_v)) / (pi (1 - E_avg)) int_light (1 - E(mu_i)) mu_i dw.  The
+# integral is taken as pi x (the Lambert form factor) x (1 - E) towards the light's centre, and bounded by its
+# value over the whole hemisphere, pi (1 - E_avg): without the bound a light whose centre sits near the horizon
+# of a near-mirror surface (1 - E(mu_c) ~ 1 while 1 - E_avg ~ 1e-5) gave a lobe ~20x the light's radiance, far
+# above the lobe's own albedo 1 - E(mu_v) (docs/robustness.md).  With it the lobe never exceeds 1 - E(mu_v).
 def _kulla_conty_area(tables, light, Position, N, V, Roughness):
     form_factor = shading.lambert(tables, light, Position, N, V, 1.0)
     to_center = op.normalize(shading.light_center(light) - Position)
     mu_c = op.saturate(op.dot(N, to_center))
     mu_v = op.saturate(op.dot(N, V))
     om_avg = tables.one_minus_e_avg(Roughness)
-    lobe = multiscatter.kulla_conty_lobe(tables.one_minus_e(mu_v, Roughness), tables.one_minus_e(mu_c, Roughness),
-                                         om_avg) * np.pi
-    return {"Lobe": op.select(op.greater(mu_v, 0.0), lobe * form_factor, 0.0), "One Minus E Avg": om_avg}
+    over_light = op.minimum(form_factor * tables.one_minus_e(mu_c, Roughness), om_avg)
+    lobe = multiscatter.kulla_conty_lobe(tables.one_minus_e(mu_v, Roughness), over_light, om_avg) * np.pi
+    return {"Lobe": op.select(op.greater(mu_v, 0.0), lobe, 0.0), "One Minus E Avg": om_avg}
 
 
 KULLA_CONTY = Lobe("kulla_conty", "Kulla-Conty", ("Roughness",), _KC_OUT, _kulla_conty_punctual, _kulla_conty_area,
                    "Kulla-Conty multiple-scattering lobe (times the cosine), without its Fresnel",
-                   "Kulla-Conty lobe over the light: Lambert form factor x (1 - E) towards the light's centre",
+                   "Kulla-Conty lobe over the light: Lambert form factor x (1 - E) towards the light's centre, bounded by "
+                   "the hemisphere's (1 - E_avg)",
                    reads_tables_punctual=True)
 
 

@@ -1,8 +1,10 @@
 """The RT Lit surface: the material's inputs turned into the terms every light and the world use.
 
 This is where the material's inputs are guarded, once, as Filament's ``getPixelParams`` does: factors
-are clamped to [0, 1], the shading normal and the view direction normalised (a zero Normal input falls
-back to the geometry's normal).  The lobes downstream only add the guards their own math needs to stay
+and reflectance colours are clamped to [0, 1] (a NaN input becomes 0: min and max ignore NaN,
+core/shading_ops.py), the emission to [0, EMISSION_MAX], the shading normal and the view direction
+normalised (a Normal input shorter than NORMAL_MIN, zero or denormal, falls back to the geometry's
+normal).  The lobes downstream only add the guards their own math needs to stay
 finite (``conventions.ALPHA_MIN``, cosine floors).
 """
 from __future__ import annotations
@@ -20,11 +22,32 @@ def dielectric_f0(ior, level):
     return op.saturate(r * r * 2.0 * level)
 
 
+#: Normal inputs shorter than this fall back to the geometry's normal.  A threshold above float32's
+#: denormals, so that float32 and float64 take the same branch (at |n| = 1e-40 the float32 dot
+#: product underflows to 0 while float64's does not; docs/robustness.md).
+NORMAL_MIN = 1e-6
+#: Emission colour and strength are each clamped to [0, EMISSION_MAX], so their product stays finite in
+#: float32 (3.4e38) whatever a texture or driver feeds them.
+EMISSION_MAX = 1e18
+
+
+def _reflectance(c):
+    """A colour that scales reflected light, clamped to [0, 1] per channel (an albedo or a tint: above 1
+    it would create energy, below 0 it would make radiance negative)."""
+    return op.vec3(*(op.saturate(op.component(c, i)) for i in range(3)))
+
+
+def _emission(c, strength):
+    bounded = op.vec3(*(op.clamp(op.component(c, i), 0.0, EMISSION_MAX) for i in range(3)))
+    return op.scale(bounded, op.clamp(strength, 0.0, EMISSION_MAX))
+
+
 def _surface(**kw):
     metallic = op.saturate(kw["Metallic"])
-    base, tint = kw["Base Color"], kw["Specular Tint"]
+    base, tint = _reflectance(kw["Base Color"]), _reflectance(kw["Specular Tint"])
     n_in = kw["Normal"]
-    n = op.vselect(op.greater(op.dot(n_in, n_in), 0.0), op.normalize(n_in), op.normalize(kw["Geometry Normal"]))
+    n = op.vselect(op.greater(op.dot(n_in, n_in), NORMAL_MIN * NORMAL_MIN), op.normalize(n_in),
+                   op.normalize(kw["Geometry Normal"]))
     f0_dielectric = op.scale(tint, dielectric_f0(kw["IOR"], kw["Specular IOR Level"]))
     f0 = op.scale(f0_dielectric, 1.0 - metallic) + op.scale(base, metallic)
     return {
@@ -37,10 +60,10 @@ def _surface(**kw):
         "F0": f0,
         "Albedo": op.scale(base, 1.0 - metallic),
         "Wrap": op.saturate(kw["Wrap"]),
-        "Sheen Color": op.scale(kw["Sheen Tint"], op.saturate(kw["Sheen Weight"])),
+        "Sheen Color": op.scale(_reflectance(kw["Sheen Tint"]), op.saturate(kw["Sheen Weight"])),
         "Cloth Weight": op.saturate(kw["Cloth Weight"]),
-        "Cloth Color": kw["Cloth Color"],
-        "Emission": op.scale(kw["Emission Color"], kw["Emission Strength"]),
+        "Cloth Color": _reflectance(kw["Cloth Color"]),
+        "Emission": _emission(kw["Emission Color"], kw["Emission Strength"]),
     }
 
 

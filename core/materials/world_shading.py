@@ -58,6 +58,7 @@ from ..ir.functions import NodeFunction
 from ..ir.interface import Socket, color, factor, vector
 from ..ir.tables import Table
 from ..ltc import polygon
+from ..ltc import shading as ltc_shading
 from ..lut.lookup import REFERENCES
 from .rt_lit_interface import SURFACE_OUTPUTS, world_input
 
@@ -249,7 +250,7 @@ def _ltc_lobe_function(title, table, description, fixed_roughness=None, use_fres
     def body(tables, **kw):
         r = fixed_roughness if fixed_roughness is not None else kw["Roughness"]
         axis, magnitude, fresnel = _ltc_axis_and_magnitude(tables, table, kw["N"], kw["V"], r)
-        amount = fresnel * PI if use_fresnel else magnitude
+        amount = fresnel * PI if use_fresnel else ltc_shading.albedo_bound(magnitude)
         return {"Axis": op.normalize(axis), "Magnitude": amount}
 
     inputs = {"N": _DIR, "V": _DIR}

@@ -122,3 +122,32 @@ def test_groups_carry_only_what_the_scene_and_material_need(empty_scene, lut_dir
     assert any("Point" in n for n in tree_node_counts(ng))
     after = render_cycles_passes(scene, (48, 48))["Combined"]
     assert after.sum() > before.sum()
+
+
+def test_lights_outside_the_render_are_not_shaded(empty_scene):
+    """Lights disabled in renders, in a collection disabled in renders, or in a collection excluded from the
+    view layer are left out (they used to be shaded: only the object's own hide_render was checked)."""
+    import bpy
+
+    from rt_lookdev.addon.materials import scene_lights
+
+    scene = empty_scene
+
+    def light(name, collection):
+        obj = bpy.data.objects.new(name, bpy.data.lights.new(name, "POINT"))
+        collection.objects.link(obj)
+        return obj
+
+    light("A shown", scene.collection)
+    light("B hidden", scene.collection).hide_render = True
+    off = bpy.data.collections.new("Off in renders")
+    scene.collection.children.link(off)
+    off.hide_render = True
+    light("C in a collection off in renders", off)
+    excluded = bpy.data.collections.new("Excluded")
+    scene.collection.children.link(excluded)
+    light("D in an excluded collection", excluded)
+    bpy.context.view_layer.layer_collection.children["Excluded"].exclude = True
+    assert [o.name for o, _ in scene_lights(scene)] == ["A shown"]
+    bpy.context.view_layer.layer_collection.children["Excluded"].exclude = False
+    assert [o.name for o, _ in scene_lights(scene)] == ["A shown", "D in an excluded collection"]

@@ -20,10 +20,10 @@ def test_report_is_written_from_the_steps(tmp_path, monkeypatch):
     job["render"] = {"settings": {"resolution_per_sphere": 8, "samples": 4, "seeds": [0, 1], "z_max": 5.0,
                                   "sys_tol": 5e-4, "ms_tol": 0.005}, "summary_markdown": "RENDER TABLE",
                      "passed": True}
-    for step in ("lut_export", "demo", "realtime_benchmark", "validation", "world_validation"):
+    for step in ("lut_export", "demo", "realtime_benchmark", "validation", "world_validation", "robustness"):
         job[step] = {"summary_markdown": f"{step.upper()} TABLE", "passed": True}
     main_job.write_report(job, tmp_path / "full")
     text = (tmp_path / "full" / "report.md").read_text()
     assert all(f"{s} TABLE" in text for s in ("RENDER", "LUT_EXPORT", "DEMO", "REALTIME_BENCHMARK", "VALIDATION",
-                                              "WORLD_VALIDATION"))
+                                              "WORLD_VALIDATION", "ROBUSTNESS"))
     assert "Skipped" not in text
