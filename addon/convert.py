@@ -205,8 +205,44 @@ def _relink(tree, src_input, dst_input):
         new.is_muted = link.is_muted
 
 
+def _socket_drivers(tree, socket):
+    """The drivers of ``socket``'s value (one per component), from the tree's animation data."""
+    if tree.animation_data is None or not hasattr(socket, "default_value"):
+        return []
+    path = socket.path_from_id("default_value")
+    return [fc for fc in tree.animation_data.drivers if fc.data_path == path]
+
+
+def _copy_driver(src, dst):
+    """Make the driver ``dst`` (a new driver F-curve's ``.driver``) compute what ``src`` computes."""
+    dst.type = src.type
+    dst.expression = src.expression
+    dst.use_self = src.use_self
+    for var in src.variables:
+        new = dst.variables.new()
+        new.name, new.type = var.name, var.type
+        for t_src, t_dst in zip(var.targets, new.targets):
+            if var.type == "SINGLE_PROP":
+                t_dst.id_type = t_src.id_type
+            t_dst.id = t_src.id
+            for attr in ("data_path", "bone_target", "transform_type", "transform_space", "rotation_mode"):
+                setattr(t_dst, attr, getattr(t_src, attr))
+
+
+def _move_drivers(tree, src, dst):
+    """Move the drivers of ``src``'s value onto ``dst``'s (a driven Principled input stays driven in RT Lit
+    and back); a driver on a component ``dst`` lacks is dropped."""
+    for fc in _socket_drivers(tree, src):
+        size = len(_value(dst)) if isinstance(_value(dst), tuple) else 0
+        if size and fc.array_index >= size:
+            continue
+        new = dst.driver_add("default_value", fc.array_index) if size else dst.driver_add("default_value")
+        _copy_driver(fc.driver, new.driver)
+        tree.animation_data.drivers.remove(fc)
+
+
 def _transfer(tree, src_node, dst_node, names):
-    """Copy values and links of the inputs ``names`` from ``src_node`` to ``dst_node``."""
+    """Copy values, links and drivers of the inputs ``names`` from ``src_node`` to ``dst_node``."""
     for name in names:
         src, dst = src_node.inputs.get(name), dst_node.inputs.get(name)
         if src is None or dst is None:
@@ -214,6 +250,7 @@ def _transfer(tree, src_node, dst_node, names):
         if name not in LINK_ONLY_INPUTS:
             _copy_value(src, dst)
         _relink(tree, src, dst)
+        _move_drivers(tree, src, dst)
 
 
 def _equal(a, b):
@@ -286,7 +323,9 @@ def _check_editable(material):
     if material is None:
         raise ConversionError("No material to convert")
     if material.library is not None:
-        raise ConversionError(f"Material '{material.name}' is linked from a library and cannot be edited")
+        raise ConversionError(f"Material '{material.name}' is linked from the library "
+                              f"'{material.library.filepath}' and cannot be edited here: make it local "
+                              "(Object > Relations > Make Local) or convert it in its own file")
     if material.node_tree is None:
         raise ConversionError(f"Material '{material.name}' has no node tree (it does not use nodes)")
     output = _active_output(material.node_tree)

@@ -98,6 +98,23 @@ CYCLES_LIGHT_BUDGET = 8
 CYCLES_LIGHT_BUDGET_WITH_WORLD = 7
 
 
+#: Up to this many lights the Sync Lights report names each; beyond, it counts them per kind (Blender
+#: truncates long reports, which cut off the warning after a list of 100 names).
+NAMED_LIGHTS_MAX = 8
+
+
+def _light_summary(records):
+    """"Key (quad), Fill (disk)" for a few lights, "96 point, 4 quad" for many, "none" for none."""
+    if not records:
+        return "none"
+    if len(records) <= NAMED_LIGHTS_MAX:
+        return ", ".join(f"{obj.name} ({kind})" for obj, kind in records)
+    counts = {}
+    for _, kind in records:
+        counts[kind] = counts.get(kind, 0) + 1
+    return ", ".join(f"{n} {kind}" for kind, n in sorted(counts.items(), key=lambda kv: -kv[1]))
+
+
 class RTL_OT_sync_lights(bpy.types.Operator):
     """Rebuild the RT Lit groups for the lights now in the scene (after adding, removing or
     changing the shape of a light; moving or editing a light needs no sync: drivers follow it)"""
@@ -120,7 +137,7 @@ class RTL_OT_sync_lights(bpy.types.Operator):
         except Exception as ex:
             self.report({'ERROR'}, f"Could not sync lights: {ex}")
             return {'CANCELLED'}
-        kinds = ", ".join(f"{obj.name} ({kind})" for obj, kind in records) or "none"
+        kinds = _light_summary(records)
         message = f"RT Lit: {len(records)} lights [{kinds}]; {len(groups)} RT Lit groups rebuilt"
         has_world = WORLD_GROUP in bpy.data.node_groups
         budget = CYCLES_LIGHT_BUDGET_WITH_WORLD if has_world else CYCLES_LIGHT_BUDGET

@@ -276,7 +276,7 @@ def _col(kw):
 def _quad_node(**kw):
     p0, p1, p2, p3, radiance = area_light_quad(_loc(kw), *_rot(kw), *_scl(kw), kw["Power"], _col(kw),
                                                kw["Size"], kw["Size Y"])
-    return {"p0": p0, "p1": p1, "p2": p2, "p3": p3, "Radiance": radiance}
+    return {"p0": p0, "p1": p1, "p2": p2, "p3": p3, "Center": _loc(kw), "Radiance": radiance}
 
 
 def _disk_node(**kw):
@@ -310,7 +310,11 @@ AREA_LIGHT_QUAD = NodeFunction(
     "RTL Area Light Quad", _quad_node,
     {**_location_sockets(), **_rotation_sockets(), **_scale_sockets(), **_power_socket("Area light"),
      **_color_sockets(), **_size_sockets("Quad")},
-    {**{f"p{i}": _corner(i) for i in range(4)}, "Radiance": _RADIANCE},
+    {**{f"p{i}": _corner(i) for i in range(4)},
+     "Center": vector("World-space centre (the light's location): the side the shading point is on is taken from "
+                      "it, which the corners of a light much larger than its distance round away", "XYZ",
+                      hide_value=True),
+     "Radiance": _RADIANCE},
     "A SQUARE or RECTANGLE Blender area light: world corners and emitted radiance (Cycles units)")
 
 AREA_LIGHT_DISK = NodeFunction(

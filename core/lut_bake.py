@@ -156,8 +156,9 @@ def bake(lut_dir=None, force=False, progress=None, groups=None, log=print, worke
         group = catalog.GROUPS[name]
         digest = catalog.inputs_hash(name)
         specs = [s for s in catalog.TABLES.values() if s.group == name]
-        for spec in specs:
-            exr_io.write_table(lut_dir / spec.filename, tables[spec.name], _metadata(spec, group, digest))
+        # a group's tables are written together or not at all (the previous files stay on failure)
+        exr_io.write_tables([(lut_dir / spec.filename, tables[spec.name], _metadata(spec, group, digest))
+                             for spec in specs])
         log(f"[bake] {name}: wrote {', '.join(s.filename for s in specs)} in {seconds:.1f} s")
         records[name] = BakeRecord(name, "baked", seconds, tuple(lut_dir / s.filename for s in specs))
     return [records[name] for name in (groups or catalog.GROUPS)]

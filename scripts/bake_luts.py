@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from rt_lookdev.core import lut_bake as bake
-from rt_lookdev.core.lut import catalog
+from rt_lookdev.core.lut import catalog, exr_io
 
 
 def _args(argv):
@@ -33,7 +33,11 @@ def _progress(group, done, total):
 def main(argv=None):
     args = _args(sys.argv[1:] if argv is None else argv)
     if not args.status:
-        bake.bake(args.lut_dir, force=args.force, progress=_progress)
+        try:
+            bake.bake(args.lut_dir, force=args.force, progress=_progress)
+        except exr_io.LutError as ex:          # e.g. a read-only folder: the message says what to do
+            print(f"bake_luts.py: error: {ex}", file=sys.stderr)
+            return 2
     status = catalog.lut_status(args.lut_dir)
     for s in status:
         print(f"  {s.state:8s} {s.message}")

@@ -5,7 +5,8 @@
   import bpy, so tests never read or write the developer's ~/.config/blender; baked world
   environments are cached in out/cache/environments (``RTL_ENVIRONMENT_CACHE``) unless set.
 - ``blender`` marker for tests that need the bpy module; fixtures ``bpy_module``
-  (imports bpy once per session: it must never be re-imported) and ``empty_scene``.
+  (imports bpy once per session: it must never be re-imported), ``empty_scene``, ``registered`` (the
+  add-on's classes) and ``relink_from_library``.
 """
 import os
 import tempfile
@@ -54,3 +55,31 @@ def tables(lut_dir):
     from rt_lookdev.core.lut import lookup
 
     return lookup.LutSet.from_folder(lut_dir)
+
+
+@pytest.fixture
+def registered(bpy_module):
+    """The add-on's classes registered (from the source tree), unregistered afterwards."""
+    from rt_lookdev import addon
+
+    addon.register()
+    yield bpy_module
+    addon.unregister()
+
+
+@pytest.fixture
+def relink_from_library(bpy_module, tmp_path):
+    """``relink(collection, name)``: move the local datablock ``bpy.data.<collection>[name]`` into a library
+    .blend (``tmp_path``/library.blend) and link it back; returns the linked datablock."""
+    def relink(collection, name):
+        data = getattr(bpy_module.data, collection)
+        library = tmp_path / "library.blend"
+        bpy_module.data.libraries.write(str(library), {data[name]})
+        data.remove(data[name])
+        with bpy_module.data.libraries.load(str(library), link=True) as (_, dst):
+            setattr(dst, collection, [name])
+        linked = getattr(dst, collection)[0]
+        assert linked.library is not None
+        return linked
+
+    return relink

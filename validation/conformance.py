@@ -118,9 +118,36 @@ def _link_emission_output(nt, out_socket, is_vector):
     nt.links.new(emission.outputs[0], mout.inputs["Surface"])
 
 
-def _build_material(bpy, ng, arrays, h, w, output_name, created):
+def _finite_mask(nt, out_socket, is_vector):
+    """A float socket: 1 where ``out_socket`` is finite (every component), else 0.  Math Compare with
+    epsilon 0 of a value with itself is |x - x| <= 0: false for NaN, and for +-Inf (Inf - Inf = NaN)."""
+    values = [out_socket]
+    if is_vector:
+        sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+        nt.links.new(out_socket, sep.inputs[0])
+        values = list(sep.outputs)
+    mask = None
+    for value in values:
+        cmp = nt.nodes.new("ShaderNodeMath")
+        cmp.operation = "COMPARE"
+        nt.links.new(value, cmp.inputs[0])
+        nt.links.new(value, cmp.inputs[1])
+        cmp.inputs[2].default_value = 0.0
+        if mask is None:
+            mask = cmp.outputs[0]
+        else:
+            mul = nt.nodes.new("ShaderNodeMath")
+            mul.operation = "MULTIPLY"
+            nt.links.new(mask, mul.inputs[0])
+            nt.links.new(cmp.outputs[0], mul.inputs[1])
+            mask = mul.outputs[0]
+    return mask
+
+
+def _build_material(bpy, ng, arrays, h, w, output_name, created, finite_mask=False):
     """The temporary material: input images -> group ``ng`` -> emission.  Returns (material, whether
-    the output is read back as RGB: vector and colour outputs)."""
+    the output is read back as RGB: vector and colour outputs).  ``finite_mask``: emit
+    ``_finite_mask`` of the output instead (a float)."""
     from ..addon import compat
     mat = compat.new_material("RTL_conformance")
     created["materials"].append(mat)
@@ -133,6 +160,8 @@ def _build_material(bpy, ng, arrays, h, w, output_name, created):
     _link_input_images(bpy, nt, coord, group, arrays, h, w, created)
     out_socket = group.outputs[output_name]
     is_vector = out_socket.type in ("VECTOR", "RGBA")      # colours read back as RGB
+    if finite_mask:
+        out_socket, is_vector = _finite_mask(nt, out_socket, is_vector), False
     _link_emission_output(nt, out_socket, is_vector)
     return mat, is_vector
 
@@ -208,9 +237,11 @@ def _cleanup(bpy, scene, created, old_camera, old_world):
             coll.remove(item)
 
 
-def render_group_outputs(ng, inputs, output_name, engine="CYCLES"):
+def render_group_outputs(ng, inputs, output_name, engine="CYCLES", finite_mask=False):
     """Cycles' (or EEVEE's: ``engine="BLENDER_EEVEE"``) value of ``ng``'s output ``output_name``
     per pixel for per-pixel ``inputs``.  EEVEE stores half floats and writes 0 for negative values.
+    ``finite_mask``: instead of the value, 1 where the renderer computed it finite and 0 where NaN or
+    Inf (which it would write as 0), as float32 (H, W).
 
     ``inputs``: group input name -> float32 array (H, W) (float sockets) or (H, W, 3) (vector).
     Returns float32 (H, W) or (H, W, 3) in the orientation of the inputs.
@@ -223,7 +254,7 @@ def render_group_outputs(ng, inputs, output_name, engine="CYCLES"):
     old_camera, old_world = scene.camera, scene.world
     tmp = tempfile.TemporaryDirectory(prefix="rtl-conformance-")
     try:
-        mat, is_vector = _build_material(bpy, ng, arrays, h, w, output_name, created)
+        mat, is_vector = _build_material(bpy, ng, arrays, h, w, output_name, created, finite_mask)
         _build_plane_and_camera(bpy, scene, mat, h, w, created)
         _build_black_world(bpy, scene, created)
         path = Path(tmp.name) / "out.exr"

@@ -128,6 +128,7 @@ def area_lobe_inputs(kind, seed=5, size=SIZE):
     if kind == "quad":
         corners = [center - u - w, center + u - w, center + u + w, center - u + w]
         vals.update({f"p{i}": c for i, c in enumerate(corners)})
+        vals["Center"] = center
     else:
         vals.update({"Center": center, "Axis U": u, "Axis V": w})
     return {k: np.asarray(a, np.float32).reshape(shape + np.shape(a)[1:]) for k, a in vals.items()}

@@ -135,7 +135,8 @@ def _material_values(rng, family, n):
             continue
         if spec is None:
             default = sock.default
-            vals[name] = np.full(n, float(default)) if sock.kind == "float" else np.tile(np.asarray(default[:3]), (n, 1))
+            vals[name] = (np.full(n, float(default)) if sock.kind == "float"
+                          else np.tile(np.asarray(default[:3]), (n, 1)))
         elif spec in ("white", "black"):
             vals[name] = np.full((n, 3), 1.0 if spec == "white" else 0.0)
         elif spec == "random":
@@ -206,6 +207,9 @@ def _light_values(rng, kind, position, normal, n):
     # rectangles and ellipses up to 1:1000 (a strip light); thinner ones are a known limit (KNOWN_LIMITS)
     aspect = _log_uniform(rng, 1.0, ASPECT_MAX, n) ** rng.choice([-1.0, 1.0], n)
     size_y = np.where(rng.random(n) < 0.5, size, _mix_special(rng, size * aspect, [0.0], 0.03))
+    # world-space extents (size x scale) stay within 1e-6 .. 1e6 m like the distances
+    size = np.minimum(size, 1e6 / np.maximum(np.abs(scale[:, 0]), 1e-30))
+    size_y = np.minimum(size_y, 1e6 / np.maximum(np.abs(scale[:, 1]), 1e-30))
     vals.update({"Size": size, "Size Y": size_y, "Spot Size": _mix_special(rng, rng.uniform(0, np.pi, n),
                                                                              [0.0, np.pi], 0.05),
                  "Spot Blend": _mix_special(rng, rng.random(n), [0.0, 1.0], 0.1)})
@@ -265,6 +269,7 @@ class Counts:
     negative: int = 0
     over_bound: int = 0          # -1: no bound for this light kind
     max_of_bound: float = 0.0    # the largest response as a fraction of its bound (area lights, world)
+    zeroed: int = 0              # image backends: exactly 0, finite, where numpy float32 is not (flushed)
     at_horizon: int = 0          # points with |mu_v| <= HORIZON_BAND (left out of the error columns)
     off_1pct: int = 0            # points whose per-unit-light response is > 0.01 from float64's
     worst_rel: float = 0.0
@@ -357,9 +362,9 @@ def as_image(values, width):
     n = len(next(iter(values.values())))
     h = -(-n // width)
     images = {}
+    index = np.arange(h * width) % n                # the last row padded with the first points again
     for k, v in values.items():
-        padded = np.concatenate([v, v[:h * width - n]], 0) if h * width > n else v
-        images[k] = padded.reshape((h, width) + v.shape[1:])
+        images[k] = v[index].reshape((h, width) + v.shape[1:])
     return images, n
 
 
@@ -369,22 +374,23 @@ def from_image(image, n):
     return flat[:n]
 
 
-def compare_backend(family, kind, backend, got, ref64, unit, values, material, seconds, renderer_zeroes_nonfinite,
-                    ref32=None):
-    """``count`` for an image-driven backend: where the renderer writes non-finite values as 0, the points
-    that came back exactly 0 while both numpy references (float32 ``ref32`` and float64) are above 1e-6 of
-    the light are counted as non-finite."""
+def compare_backend(family, kind, backend, got, ref64, unit, values, material, seconds, finite=None, ref32=None):
+    """``count`` for an image-driven backend.  ``finite``: the renderer's own finiteness per point (Cycles
+    writes NaN and Inf as 0, so it is rendered as a second image, ``conformance.render_group_outputs(...,
+    finite_mask=True)``); None: taken from ``got``.  Points that came back exactly 0 while finite and while
+    numpy's float32 value is above 1e-6 of the light are counted as ``zeroed`` (Cycles flushes denormal
+    intermediates to zero)."""
     got = np.asarray(got, np.float64)
-    nonfinite = None
-    if renderer_zeroes_nonfinite:
+    nonfinite = None if finite is None else ~np.asarray(finite, bool)
+    c = count(family, kind, backend, got, ref64, unit, values, material, seconds, nonfinite)
+    if ref32 is not None:
         floor = 1e-6 * np.maximum(np.asarray(unit, np.float64), 0.0)
-        nonzero = np.abs(np.asarray(ref64, np.float64)).max(-1) > floor
-        if ref32 is not None:
-            nonzero &= np.abs(np.asarray(ref32, np.float64)).max(-1) > floor
-        # at the view's horizon (|mu_v| < HORIZON_BAND) a renderer may take the back-facing branch (0) where
-        # numpy takes the other: a switch, not a non-finite value
-        nonfinite = (got == 0.0).all(-1) & nonzero & (np.abs(view_cosine(values)) > HORIZON_BAND)
-    return count(family, kind, backend, got, ref64, unit, values, material, seconds, nonfinite)
+        zero = (got == 0.0).all(-1) & (np.abs(np.asarray(ref32, np.float64)).max(-1) > floor) \
+            & (np.abs(view_cosine(values)) > HORIZON_BAND)
+        if nonfinite is not None:
+            zero &= ~nonfinite
+        c.zeroed = int(zero.sum())
+    return c
 
 
 def sweep_numpy(points_per_kind, luts, seed=0, families=FAMILIES, kinds=LIGHT_KINDS, log=print):
@@ -476,8 +482,7 @@ def sweep_glsl(cases, luts, width=1024, log=print):
         t = time.perf_counter()
         got = runner.evaluate(module, images, material.tables(luts), outputs=[RADIANCE_OUTPUT])[RADIANCE_OUTPUT]
         seconds = time.perf_counter() - t
-        c = compare_backend(family, kind, "GLSL 4.50", from_image(got, n), ref64, unit, values, material, seconds,
-                            renderer_zeroes_nonfinite=False)
+        c = compare_backend(family, kind, "GLSL 4.50", from_image(got, n), ref64, unit, values, material, seconds)
         counts.append(c)
         log(f"[robustness] GLSL {family_name} / {kind}: {c.points} points, {c.failures} failures, "
             f"worst rel {c.worst_rel:.2g} ({seconds:.1f} s)")
@@ -486,7 +491,8 @@ def sweep_glsl(cases, luts, width=1024, log=print):
 
 def sweep_cycles(cases, luts, width=1024, log=print):
     """[Counts] of the node groups rendered by Cycles (validation/conformance.py: one pixel per point) on
-    the numpy sweep's inputs.  Cycles writes non-finite pixels as 0, so those are found against float64."""
+    the numpy sweep's inputs.  Cycles writes non-finite pixels as 0, so a second render of each case gives
+    its finiteness per pixel (``finite_mask``)."""
     from ..addon.node_emit import ensure_function_group
     from .conformance import LAST_RENDER_SECONDS, render_group_outputs
 
@@ -497,8 +503,10 @@ def sweep_cycles(cases, luts, width=1024, log=print):
         tables = material.tables(luts)
         ng = ensure_function_group(material.function, tables)
         got = render_group_outputs(ng, images, RADIANCE_OUTPUT)
+        seconds = LAST_RENDER_SECONDS[0]
+        finite = render_group_outputs(ng, images, RADIANCE_OUTPUT, finite_mask=True) > 0.5
         c = compare_backend(family, kind, "Cycles (node groups)", from_image(got, n), ref64, unit, values, material,
-                            LAST_RENDER_SECONDS[0], renderer_zeroes_nonfinite=True, ref32=ref32)
+                            seconds, finite=from_image(finite, n), ref32=ref32)
         counts.append(c)
         log(f"[robustness] Cycles {family_name} / {kind}: {c.points} points, {c.failures} failures, "
             f"worst rel {c.worst_rel:.2g} ({c.seconds:.1f} s)")
@@ -514,9 +522,10 @@ def summary(counts):
     out = {}
     for c in counts:
         row = out.setdefault(c.backend, {}).setdefault(c.family, {
-            "points": 0, "nan": 0, "inf": 0, "negative": 0, "over_bound": 0, "at_horizon": 0, "off_1pct": 0, "max_of_bound": 0.0,
+            "points": 0, "nan": 0, "inf": 0, "negative": 0, "over_bound": 0, "zeroed": 0, "at_horizon": 0,
+            "off_1pct": 0, "max_of_bound": 0.0,
             "worst_rel": 0.0, "worst_kind": None, "worst_at": {}})
-        for key in ("points", "nan", "inf", "negative", "at_horizon", "off_1pct"):
+        for key in ("points", "nan", "inf", "negative", "zeroed", "at_horizon", "off_1pct"):
             row[key] += getattr(c, key)
         row["over_bound"] += max(c.over_bound, 0)
         row["max_of_bound"] = max(row["max_of_bound"], c.max_of_bound)
@@ -555,22 +564,54 @@ FINDINGS = (
     ("Denormal normals (|n| ~ 1e-40) shaded with an arbitrary normal in float64 and the geometry's in float32",
      "RTL Surface's zero-normal test dot(n, n) > 0 underflows in float32 only", "threshold |n| > 1e-6 "
      "(surface.NORMAL_MIN)", "test_denormal_normal_falls_back"),
+    ("Quads much larger than their distance to the point went dark (a 10^4 m panel 1 cm above it: 0 where the "
+     "form factor is ~1) or, in Cycles, black on one backend and lit on the other (90 of 12.2 M sweep pixels)",
+     "ltc/polygon.py: the side and edge-on tests measured from corner p0 (as ltc_code), whose float32 rounding "
+     "(~6e-8 |p0|) exceeds the point's distance to such a light", "the tests measure from the light's centre "
+     "(its location, a new Center input of the quad integral)", "test_huge_light_just_above_is_not_edge_on"),
+    ("A 1 x 1 world image baked as a varying world (SH Y_2,0 = -3.4 for a constant)", "core/environment: the "
+     "bake's quadrature over one row has a single node, at the equator", "images below 16 x 32 texels are "
+     "replicated up to it first (equirect.replicate_to_minimum)", "test_a_one_texel_world_bakes_as_a_constant"),
+    ("Lights in collections disabled in renders or excluded from the view layer were shaded",
+     "addon/materials.py scene_lights checked only the object's hide_render", "is_rendered: the object, its "
+     "collections and the view layers' layer collections", "test_lights_outside_the_render_are_not_shaded"),
+    ("Sync Lights with 100 lights: the capacity warning was cut off", "the report listed every light's name and "
+     "Blender truncates long reports", "beyond 8 lights the report counts them per kind",
+     "test_sync_lights_with_no_lights_and_with_a_hundred"),
+    ("Convert lost the drivers of driven Principled inputs", "only values and links were transferred",
+     "drivers move with the value, both ways", "test_driven_inputs_stay_driven_both_ways"),
+    ("A LUT write that failed half way (read-only folder, full disk) left a group with one new and one old "
+     "table", "each table was written and renamed on its own", "a group's tables are written to .tmp files "
+     "and renamed together (exr_io.write_tables); LutWriteError names the file, the cause and the way out",
+     "test_a_failed_write_keeps_the_previous_tables_and_names_the_fix"),
+    ("Disks and ellipses much larger than their distance gave about half their light in float32 (a 10^5 m disk "
+     "10 um away: 0.5 where float64 gives 1)", "ltc/disk.py: after the scaling by the light's extent, the "
+     "centre C (~ distance / size) is lost against V1, V2 in the cone-axis sums", "within 1e-3 of the smaller "
+     "semi-axis the cone is the half-space: axis = the light's normal, |F| = |V1 x V2| / (|V1 x V2| + |C|^2) "
+     "(disk.NEAR_PLANE)", "test_large_disk_just_above_is_fully_lit"),
+    ("A light centred exactly on the shading point was integrated (0.20 of the light in float32, 0.03 in "
+     "float64) instead of counting as seen edge-on", "the edge-on test |side| < 1e-5 |p| |n| is false for p = 0",
+     "off the plane only where |side| > margin (polygon.beyond_plane), for quads and disks",
+     "test_light_centred_on_the_point_is_edge_on"),
     ("NaN texture coordinates raised IndexError for the whole batch", "texel index of NaN", "texel 0 "
      "(semantics.texel_index)", "test_nan_lookup_gives_a_value"),
 )
 
 #: Known, measured, not fixed: the sweep reports their share of points (docs/robustness.md).
 KNOWN_LIMITS = (
-    ("Quads more than ~10^5 times wider than their distance to the point (a 10^4 m panel 1 cm above it)",
-     "the edge-on guard (ltc/polygon.py edge_on, EDGE_ON_SIN = 1e-5) compares the distance to the light's plane "
-     "with the distance to a corner, so the point counts as in the plane and gets 0 where the form factor is "
-     "~1; float32 and float64 agree, so the sweep's float64 comparison cannot see it (found by "
-     "test_huge_light_just_above_is_not_edge_on, a strict xfail until fixed)"),
-    ("Rectangles and ellipses thinner than 1:10^4 (beyond ASPECT_MAX; an earlier draw of independent sizes "
-     "over 12 decades)", "float32 ellipses seen from less than ~10^-3 of their width return up to 0.5 of the "
-     "light where float64 and an exact 200,000-gon integral give 0.01-0.07 (the cone axis of Heitz & Hill "
-     "2017's sphere approximation comes from a cancelling sum); Cycles returns 0 (a non-finite value) for the "
-     "GGX LTC integral of such quads 10^3-10^5 m long in about 1% of draws"),
+    ("Rectangles and ellipses thinner than 1:1000 (ASPECT_MAX; not drawn)", "an earlier draw of independent sizes "
+     "over 12 decades (aspect up to 1e12) found float32 ellipses seen from close returning up to 0.5 of the "
+     "light against an exact 200,000-gon integral of 0.01-0.07; not measured since"),
+    ("Lights smaller than ~1e-4 m within ~1e-5 m of a point at ~1 m from the world origin", "float32 world "
+     "positions resolve ~6e-8 m there, so the light's corners relative to the point carry a few % error before "
+     "any shading math (the 'off > 0.01' points of the quad rows); every float32 renderer shares it"),
+    ("Spot lights with a hard edge (Spot Blend 0, or nearly), at points on the cone's edge", "the attenuation "
+     "jumps from 1 to 0 there by design; float32 and float64 put points within rounding of the edge on "
+     "different sides (the spot rows' worst error, 1)"),
+    ("GLSL on llvmpipe: near-mirror GGX (r < 0.05) under disks 100-10^5 m wide", "the disk's LTC matrices reach "
+     "1e8 there and llvmpipe's sqrt / acos / FMA contraction round differently from numpy's, which that "
+     "conditioning multiplies: up to 49x float64 at single points, 589 of 12.2 M points beyond 1% of the light "
+     "(numpy float32: 415)"),
     ("Views exactly in the tangent plane (|mu_v| < ~1e-7)", "float32 and float64 fall on different sides of "
      "the back-facing switch (radiance 0 below the horizon), so the response jumps there by design"),
 )
@@ -649,7 +690,8 @@ def markdown(result):
              f"(quad, disk, point, spot, sun; seed {result['seed']}); the image backends evaluate "
              + ("the same points" if result["image_points"] is None else
                 f"the first {result['image_points']:,} of them per kind") +
-             " as input images.  Non-finite Cycles pixels (written as 0) are found against numpy float64.", "",
+             " as input images.  Cycles writes NaN and Inf pixels as 0, so each Cycles case is rendered twice: "
+             "its value, and its own finiteness per pixel (Math Compare of the value with itself).", "",
              f"Failures (NaN + Inf + negative + over the energy bound by more than {result['bound_tolerance']:g}): "
              f"**{result['failures']}**.  Run time {result['seconds']} s ({result['machine']}).", ""]
     for backend, why in result["skipped"].items():
@@ -658,19 +700,22 @@ def markdown(result):
         lines.append("")
     for backend, families in result["summary"].items():
         lines += [f"## {backend}", "",
-                  "| family | points | NaN | Inf | negative | over bound | max / bound | off > 0.01 | "
-                  "worst rel. error vs float64 (where) |", "|---|---|---|---|---|---|---|---|---|"]
+                  "| family | points | NaN | Inf | negative | over bound | max / bound | flushed to 0 | off > 0.01 | "
+                  "worst rel. error vs float64 (where) |", "|---|---|---|---|---|---|---|---|---|---|"]
         for name, row in families.items():
             where = ", ".join(f"{k} {v:.3g}" for k, v in row["worst_at"].items())
             lines.append(f"| {name} | {row['points']:,} | {row['nan']} | {row['inf']} | {row['negative']} | "
-                         f"{row['over_bound']} | {row['max_of_bound']:.4f} | {row['off_1pct']} | "
+                         f"{row['over_bound']} | {row['max_of_bound']:.4f} | {row['zeroed']} | {row['off_1pct']} | "
                          f"{row['worst_rel']:.2g} ({row['worst_kind']}: {where}) |")
         lines.append("")
     lines += ["The bound is per unit of light: the emitted radiance of an area light, radiance 1 for the "
               "constant environment; 1 for one lobe on a white surface (white furnace), 2 + the sheen weight "
               "where diffuse, specular and sheen are added (as the talk and Filament add them).  Punctual lights "
               "have none (a delta light on a mirror) and count toward NaN / Inf / negative only.  \"off > 0.01\": "
-              "points whose response differs from float64's by more than 1% of the light.  The error columns leave "
+              "points whose response differs from float64's by more than 1% of the light.  \"flushed to 0\": exactly 0 "
+              "(and finite) in an image backend where numpy float32 is above 1e-6 of the light: Cycles flushes "
+              "denormal intermediates to zero (near-mirror Kulla-Conty lobes, 1 - E_avg ~ 1e-11, under faint "
+              "lights), where numpy keeps them.  The error columns leave "
               f"out views within {HORIZON_BAND:g} of the tangent plane, where float32 and float64 (or Cycles and "
               "numpy) may take either side of the back-facing switch.", "",
               "## Found and fixed", "", "| defect | cause | fix | regression test |", "|---|---|---|---|"]

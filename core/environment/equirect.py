@@ -265,6 +265,24 @@ def bilinear(image, x, y):
     return top * (1 - fy) + bottom * fy
 
 
+#: The smallest equirect grid the bake integrates on (rows; columns = 2 x rows).  An image with fewer rows
+#: (a 1 x 1 constant world, a 2 x 1 gradient) is replicated up to it first: with one row, the quadrature
+#: has a single node at the equator and a constant world came out with Y_2,0 = -3.4 (docs/robustness.md).
+MIN_BAKE_HEIGHT = 16
+
+
+def replicate_to_minimum(image, min_height=MIN_BAKE_HEIGHT):
+    """``image`` with each texel repeated k x k times (k the smallest power of two bringing the height to
+    ``min_height`` and the width to 2 x that): the same piecewise-constant world, on a grid the bake's
+    quadrature integrates.  Larger images are returned as they are."""
+    image = np.asarray(image)
+    h, w = image.shape[:2]
+    k = 1
+    while h * k < min_height or w * k < 2 * min_height:
+        k *= 2
+    return image if k == 1 else np.repeat(np.repeat(image, k, axis=0), k, axis=1)
+
+
 def downsample(image, factor=2):
     """Area average of an equirect image over factor x factor blocks, each texel weighted by its
     exact solid angle (so the integral of the image over every block is preserved exactly)."""

@@ -416,6 +416,7 @@ def bake_environment_image(image, name, source, out_dir, settings=PrefilterSetti
         raise ValueError(f"expected an (H, W, 3) image, got shape {image.shape}")
     source = str(source)
     source_hash = equirect.image_hash(image)
+    image = equirect.replicate_to_minimum(image)              # tiny images: the same world, integrable
     seconds = {"read": time.perf_counter() - t_start}          # hashing (bake_environment adds the file read)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -64,6 +64,11 @@ def _mat_vec(m, x):
     return np.einsum("...ij,...j->...i", m, x)
 
 
+#: Within this fraction of its smaller semi-axis from a light's centre, the ellipse is seen as a plane
+#: (``ellipse_form_factor``).
+NEAR_PLANE = 1e-3
+
+
 # Negative root of x^3 - T x^2 + S x + D = 0 (three real roots, exactly one negative).
 # Viete's trigonometric solution (e.g. Blinn 2007, "How to Solve a Cubic Equation, Part 5: Back to
 # Numerics", IEEE CG&A 27(3)) gives each root with an error relative to the largest one; the
@@ -113,7 +118,20 @@ def ellipse_form_factor(c, v1, v2):
     form_factor = op.minimum(op.safe_div(op.absolute(cn), op.sqrt(det + lam * lam * (trace - 2.0 * lam))), 1.0)
     det2 = nn - lam * (g - lam)
     x = op.scale(c, det2) + op.scale(v1, op.dot(n, a) + lam * h13) + op.scale(v2, op.dot(n, b) + lam * h23)
-    return form_factor, op.normalize(x), cn
+    # Close to a large ellipse (docs/robustness.md): after the scaling |C| ~ distance / size, and for
+    # distances below NEAR_PLANE x the smaller semi-axis float32 loses C against V1 and V2 in the sums above
+    # (a 10^5 m disk 10 um away gave half its light).  There the cone is the half-space on the light's side:
+    # the axis is the light's normal towards it and |F| = |V1 x V2| / (|V1 x V2| + |C|^2), exact for a point on
+    # the axis of a circle (R^2 / (R^2 + h^2)) and within O(NEAR_PLANE^2) elsewhere in the region.
+    # |C|^2 (|V1|^2 + |V2|^2) < NEAR_PLANE^2 |V1 x V2|^2: |C| below NEAR_PLANE x the smaller semi-axis (or
+    # up to sqrt(2) less)
+    cc = op.dot(c, c)
+    near = op.less(cc * g, NEAR_PLANE * NEAR_PLANE * nn)
+    n_len = op.sqrt(nn)
+    toward = op.scale(n, op.safe_div(polygon._sign(op.less(cn, 0.0), cn), n_len))
+    axis = op.vselect(near, toward, op.normalize(x))
+    near_form_factor = op.safe_div(n_len, n_len + cc)
+    return op.select(near, near_form_factor, form_factor), axis, cn
 
 
 def ellipse_vector_form_factor(c, v1, v2):
@@ -128,9 +146,9 @@ def disk_integral_transformed(c, v1, v2, two_sided, sphere_table=None):
     form_factor, axis, cn = ellipse_form_factor(c, v1, v2)
     value = spheres.clipped_sphere_integral(form_factor, op.component(axis, 2), sphere_table)
     # seen edge-on (polygon.EDGE_ON_SIN; the test is scale-free, so the unscaled light serves)
-    in_plane = op.less(op.absolute(op.dot(c, op.cross(v1, v2))),
-                       polygon.EDGE_ON_SIN * op.length(c) * op.length(op.cross(v1, v2)))
-    return op.select(in_plane, 0.0, op.select(op.less(cn, 0.0), value * two_sided, value))
+    off = polygon.beyond_plane(op.dot(c, op.cross(v1, v2)),
+                               polygon.EDGE_ON_SIN * op.length(c) * op.length(op.cross(v1, v2)))
+    return op.select(off, op.select(op.less(cn, 0.0), value * two_sided, value), 0.0)
 
 
 def ltc_disk_integral_packed(c, center, axis_u, axis_v, two_sided=False, sphere_table=None):

@@ -54,12 +54,12 @@ FRAME_SIN2_MIN = 2e-6
 #: branch multiplies v1 x v2 (length sin(theta)) by 1/(2 sin(theta)), which stays <= 1/2.
 EDGE_SIN2_MIN = 1e-30
 
-#: A light whose plane passes within this angle (radians, as |p0 . n| / (|p0| |n|)) of the shading
+#: A light whose plane passes within this angle (radians, as |c . n| / (|c| |n|), c its centre) of the shading
 #: point is seen edge-on and gives 0.  Exactly in the plane the answer is a discontinuity (0 seen
 #: from the plane, the full hemisphere just in front of a light the point lies on), and which side
 #: float32 rounding picks differs between numpy and the Cycles/EEVEE kernels; this margin (100x
 #: float32 rounding of the dot product) makes all three agree.  A point nearer to the light's
-#: plane than 1e-5 of its distance to the light's first corner is treated as lying in it.
+#: plane than 1e-5 of its distance to the light's centre is treated as lying in it (``off_plane``).
 EDGE_ON_SIN = 1e-5
 
 
@@ -213,18 +213,37 @@ def light_normal(points):
     return _sum([op.cross(d[i], d[i + 1]) for i in range(1, len(pts) - 1)])
 
 
-def behind(points):
-    """True (1) where the origin lies behind the light (p0 . n < 0, ltc_code ``ltc_quad.fs``)."""
+# The side of the light's plane the origin is on, from a point of the plane: ltc_code takes corner p0.  A
+# light much larger than its distance to the origin has corners |p0| >> that distance, and their float32
+# rounding (~6e-8 |p0|) decides the side, so the caller gives the light's centre (``center``, transformed
+# like the corners): for such a light it is known to its own distance's precision (docs/robustness.md).
+# Without one, the corners' mean (never farther than the farthest corner).
+def _plane_point(pts, center):
+    if center is not None:
+        return center
+    return op.scale(_sum(list(pts)), 1.0 / len(pts))
+
+
+def behind(points, center=None):
+    """True (1) where the origin lies behind the light (p . n < 0, ltc_code ``ltc_quad.fs``; p = ``center`` or
+    the corners' mean where ltc_code takes p0)."""
     pts = _vectors(points)
-    return op.less(op.dot(pts[0], light_normal(pts)), 0.0)
+    return op.less(op.dot(_plane_point(pts, center), light_normal(pts)), 0.0)
 
 
-def edge_on(points):
-    """True (1) where the origin lies in the light's plane, to within ``EDGE_ON_SIN``."""
+def off_plane(points, center=None):
+    """1 where the origin lies off the light's plane by more than ``EDGE_ON_SIN`` (measured from ``center`` or
+    the corners' mean); 0 where the light is seen edge-on and gives 0."""
     pts = _vectors(points)
     normal = light_normal(pts)
-    side = op.dot(pts[0], normal)
-    return op.less(op.absolute(side), EDGE_ON_SIN * op.length(pts[0]) * op.length(normal))
+    ref = _plane_point(pts, center)
+    return beyond_plane(op.dot(ref, normal), EDGE_ON_SIN * op.length(ref) * op.length(normal))
+
+
+def beyond_plane(side, margin):
+    """1 where |side| > margin: strictly, so that a light centred on the point (side = margin = 0) counts as
+    seen edge-on, as any other point of its plane does."""
+    return op.greater(op.absolute(side), margin)
 
 
 # --- horizon clipping (exact reference, numpy only) ----------------------------------------------
@@ -261,26 +280,33 @@ def _as_float(minv, corners):
 # Hill & Heitz 2017 (ltc_code ``ltc_quad.fs``, clipless branch; docs/area_lights.md, "Clipless
 # evaluation"): |F| and z = F.z/|F|;
 # behind the light z flips (two-sided) or the light is dark (one-sided); horizon from the sphere table.
-def polygon_integral_clipless(points, two_sided, sphere_table=None):
+# The side tests take the polygon before the transform, as ltc_code does (Minv has a positive
+# determinant, so the side is the same), from ``center`` (``_plane_point``).
+def polygon_integral_clipless(transformed, two_sided, sphere_table=None, untransformed=None, center=None):
     """Clipless integral of the clamped cosine over a polygon already transformed by Minv (K vectors,
     a sequence or an (..., K, 3) array).  ``two_sided``: bool or 0/1 (an Expr when traced);
-    ``sphere_table``: see ``sphere_table.clipped_sphere_integral`` (a Table when traced)."""
-    pts = _vectors(points)
+    ``sphere_table``: see ``sphere_table.clipped_sphere_integral`` (a Table when traced);
+    ``untransformed``: the polygon before the transform, for the side tests (default: ``transformed``),
+    ``center``: a point of its plane there (default: its corners' mean)."""
+    pts = _vectors(transformed)
+    plane = pts if untransformed is None else _vectors(untransformed)
     f = vector_form_factor([op.normalize(q) for q in pts])
     length = op.length(f)
     z = op.safe_div(op.component(f, 2), length)
-    back = behind(pts)
+    back = behind(plane, center)
     z = op.select(back, -z, z)
     # |F| <= 1 for any spherical region; the clamp removes the edge fit's excess near |F| = 1
     value = spheres.clipped_sphere_integral(op.saturate(length), z, sphere_table)
-    return op.select(edge_on(pts), 0.0, op.select(back, value * two_sided, value))
+    return op.select(off_plane(plane, center), op.select(back, value * two_sided, value), 0.0)
 
 
-def ltc_polygon_integral_packed(c, corners, two_sided=False, sphere_table=None):
+def ltc_polygon_integral_packed(c, corners, two_sided=False, sphere_table=None, center=None):
     """Clipless integral of the LTC with packed entries c = (c0, c1, c2, c3) over the polygon
-    ``corners`` (K vectors in the local frame, relative to the shading point); traceable."""
-    return polygon_integral_clipless([matrix.transform_packed(c, q) for q in _vectors(corners)], two_sided,
-                                     sphere_table)
+    ``corners`` (K vectors in the local frame, relative to the shading point; ``center``: the light's
+    centre there, for the side tests); traceable."""
+    corners = _vectors(corners)
+    return polygon_integral_clipless([matrix.transform_packed(c, q) for q in corners], two_sided, sphere_table,
+                                     corners, center)
 
 
 # Heitz et al. 2016 (ltc_code ``ltc_quad.fs``, clipped branch): clip, normalise, exact edges;
@@ -298,7 +324,7 @@ def ltc_polygon_integral(minv, corners, two_sided=False, sphere_table=None, meth
     minv, corners = _as_float(minv, corners)
     transformed = transform(minv, corners)
     if method == "clipless":
-        value = np.asarray(polygon_integral_clipless(transformed, two_sided, sphere_table))
+        value = np.asarray(polygon_integral_clipless(transformed, two_sided, sphere_table, corners))
     elif method == "clipped":
         value = _integral_clipped(transformed, two_sided)
     else:
@@ -325,7 +351,8 @@ def ltc_polygon_vector_form_factor(minv, corners):
 def _quad_integral_node(tables, **inputs):
     c = tuple(inputs[f"c{i}"] for i in range(4))
     corners = [inputs[f"p{i}"] for i in range(4)]
-    return {"Integral": ltc_polygon_integral_packed(c, corners, inputs["Two Sided"], tables.sphere_table())}
+    return {"Integral": ltc_polygon_integral_packed(c, corners, inputs["Two Sided"], tables.sphere_table(),
+                                                    inputs["Center"])}
 
 
 _C_TIPS = {"c0": "Minv[0][0] (R of the LTC matrix table)", "c1": "Minv[2][0] (G of the LTC matrix table)",
@@ -344,7 +371,11 @@ LTC_QUAD_INTEGRAL = NodeFunction(
     inputs=dict(LTC_MATRIX_SOCKETS, **{
         f"p{i}": vector(f"Corner {i} of the quad in the local shading frame (T1, T2, N), relative to the "
                         "shading point; (p1 - p0) x (p3 - p0) points away from the lit side", "XYZ")
-        for i in range(4)}, **{"Two Sided": TWO_SIDED_SOCKET}),
+        for i in range(4)}, **{
+        "Center": vector("Centre of the quad in the local shading frame, relative to the shading point: the side "
+                         "tests use it (more precise than the corners for lights much larger than their distance)",
+                         "XYZ"),
+        "Two Sided": TWO_SIDED_SOCKET}),
     outputs={"Integral": Socket("float", 0.0, 0.0, 1.0, "FACTOR",
                                 "Integral of the normalised LTC over the light, horizon-clipped (sphere table): "
                                 "multiply by the lobe's magnitude")},

@@ -35,9 +35,11 @@ class QuadLight:
     """A planar quad: four corners in order, as a sequence of vectors (arrays (..., 3) or Expr vectors)
     or an array (..., 4, 3).  One-sided lights emit on the side away from which (c1 - c0) x (c3 - c0)
     points (corners clockwise seen from the lit side; ltc_code's convention, ``polygon.behind``).
-    ``two_sided``: bool, or a 0/1 float / Expr."""
+    ``two_sided``: bool, or a 0/1 float / Expr.  ``center_point``: the centre, when known more precisely
+    than the corners' mean (the light's location: the side test uses it, ``polygon.behind``)."""
     corners: object
     two_sided: object = False
+    center_point: object = None
 
     def corner_list(self):
         corners = polygon._vectors(self.corners)
@@ -46,6 +48,8 @@ class QuadLight:
         return corners
 
     def center(self):
+        if self.center_point is not None:
+            return self.center_point
         return op.scale(functools.reduce(operator.add, self.corner_list()), 0.25)
 
     def integral(self, tables, c, frame, p):
@@ -53,6 +57,7 @@ class QuadLight:
         local = [polygon.frame_coordinates(frame, q - p) for q in self.corner_list()]
         args = {f"c{i}": c[i] for i in range(4)}
         args.update({f"p{i}": local[i] for i in range(4)})
+        args["Center"] = polygon.frame_coordinates(frame, self.center() - p)
         args["Two Sided"] = self.two_sided
         return polygon.LTC_QUAD_INTEGRAL(tables, **args)["Integral"]
 

@@ -40,6 +40,14 @@ class LutMismatchError(LutError):
     pass
 
 
+class LutWriteError(LutError):
+    """A LUT file cannot be written (a read-only folder, a full disk, a folder removed meanwhile)."""
+
+
+WRITE_HINT = ("the LUT folder must be writable and stay in place while tables are written: choose another with "
+              "--lut-dir or the add-on's LUT folder preference")
+
+
 def content_hash(table):
     """SHA-256 of a (H, W, 4) table as little-endian float32."""
     data = np.ascontiguousarray(np.asarray(table, dtype="<f4"))
@@ -47,13 +55,46 @@ def content_hash(table):
 
 
 def write_table(path, table, metadata):
-    """Write a (H, W, 4) table to ``path`` atomically; returns the content hash.
+    """Write a (H, W, 4) table to ``path`` atomically; returns the content hash (``write_tables``)."""
+    return write_tables([(path, table, metadata)])[0]
+
+
+def write_tables(items):
+    """Write [(path, (H, W, 4) table, metadata)] all or none: every file goes to ``<name>.tmp`` first and
+    replaces its target only when all are written, so an interrupted or failed write leaves the previous
+    files as they were and no partial file.  Returns the content hashes.  ``LutWriteError`` (naming the
+    file, the cause and what to do) when a file cannot be written.
 
     ``metadata`` maps attribute names (without the ``rtl.`` prefix) to str (EXR ``string``), int
     (``int``, 32-bit; bool is stored as 0/1) or float (``float``, rounded to 32 bits).  Written with
     the OpenEXR package when it is importable, else with the built-in writer (exr_writer.py; Blender's
     bundled Python lacks the package): the same attributes, the same pixels, ZIP compression.
     """
+    prepared = [_prepared(Path(path), table, metadata) for path, table, metadata in items]
+    written = []
+    try:
+        for path, channels, attributes, _ in prepared:
+            tmp = path.with_name(path.name + ".tmp")
+            written.append(tmp)
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                _write_exr(tmp, channels, attributes)
+            except OSError as ex:
+                raise LutWriteError(f"cannot write {path}: {ex.strerror or ex}; {WRITE_HINT}") from ex
+        for (path, *_), tmp in zip(prepared, written):
+            try:
+                tmp.replace(path)
+            except OSError as ex:
+                raise LutWriteError(f"cannot replace {path}: {ex.strerror or ex}; {WRITE_HINT}") from ex
+    except BaseException:
+        for tmp in written:
+            tmp.unlink(missing_ok=True)
+        raise
+    return [digest for *_, digest in prepared]
+
+
+def _prepared(path, table, metadata):
+    """(path, channels, attributes, content hash) of one table, checked before anything is written."""
     table = np.asarray(table, dtype=np.float32)
     if table.ndim != 3 or table.shape[2] != 4:
         raise ValueError(f"expected a (H, W, 4) table, got shape {table.shape}")
@@ -66,16 +107,7 @@ def write_table(path, table, metadata):
         exr_writer.attribute_value(name, value)
     stored = np.flipud(table)
     channels = {name: np.ascontiguousarray(stored[:, :, c]) for c, name in enumerate(CHANNELS)}
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        _write_exr(tmp, channels, attributes)
-        tmp.replace(path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return digest
+    return path, channels, attributes, digest
 
 
 def _write_exr(path, channels, attributes):

@@ -224,7 +224,7 @@ LOBES = {lobe.key: lobe for lobe in (GGX, KULLA_CONTY, LAMBERT, COD, WRAPPED, CL
 
 def _area_light(kind, kw):
     if kind == "quad":
-        return shading.QuadLight([kw["p0"], kw["p1"], kw["p2"], kw["p3"]])
+        return shading.QuadLight([kw["p0"], kw["p1"], kw["p2"], kw["p3"]], center_point=kw["Center"])
     return shading.DiskLight(kw["Center"], kw["Axis U"], kw["Axis V"])
 
 

@@ -407,3 +407,48 @@ def test_principled_in_a_frame_behind_a_reroute(bpy_module, convert, factory):
     assert p.parent == frame and not p.hide
     assert tuple(getattr(p, "location_absolute", p.location)) == pytest.approx(location)
     assert _surface_source(tree) == p
+
+
+def test_driven_inputs_stay_driven_both_ways(bpy_module, convert, factory):
+    """A Principled input driven by an object's property is driven on the RT Lit node after Convert, and on
+    the Principled again after converting back (the drivers move, so one evaluates at a time)."""
+    bpy = bpy_module
+    mat = _principled_material(bpy, "Driven")
+    tree = mat.node_tree
+    target = bpy.data.objects.new("Driver Target", None)
+    bpy.context.scene.collection.objects.link(target)
+    target.location = (0.25, 0.0, 0.0)
+    fc = tree.nodes["Principled BSDF"].inputs["Roughness"].driver_add("default_value")
+    var = fc.driver.variables.new()
+    var.name, var.type = "x", "TRANSFORMS"
+    var.targets[0].id = target
+    var.targets[0].transform_type = "LOC_X"
+    fc.driver.expression = "x * 2"
+    tint = tree.nodes["Principled BSDF"].inputs["Sheen Tint"].driver_add("default_value", 1)
+    tint.driver.expression = "0.125"
+    convert.principled_to_rt_lit(mat, factory)
+    rt = convert.find_rt_lit_node(mat)
+    paths = {(d.data_path, d.array_index): d for d in tree.animation_data.drivers}
+    rough = paths[(rt.inputs["Roughness"].path_from_id("default_value"), 0)]
+    assert rough.driver.expression == "x * 2" and rough.driver.variables[0].targets[0].id == target
+    assert rough.driver.variables[0].targets[0].transform_type == "LOC_X"
+    assert (rt.inputs["Sheen Tint"].path_from_id("default_value"), 1) in paths
+    assert len(tree.animation_data.drivers) == 2                       # moved, not copied
+    bpy.context.view_layer.update()
+    bpy.context.evaluated_depsgraph_get().update()
+    convert.rt_lit_to_principled(mat)
+    p = _surface_source(tree)
+    paths = {(d.data_path, d.array_index) for d in tree.animation_data.drivers}
+    assert paths == {(p.inputs["Roughness"].path_from_id("default_value"), 0),
+                     (p.inputs["Sheen Tint"].path_from_id("default_value"), 1)}
+
+
+def test_linked_material_is_refused_with_the_fix(bpy_module, convert, factory, relink_from_library):
+    """A material linked from a library: an error naming the library and how to make it local; unchanged."""
+    bpy = bpy_module
+    _principled_material(bpy, "Library Material")
+    mat = relink_from_library("materials", "Library Material")
+    before = _snapshot_tree(mat.node_tree)
+    with pytest.raises(convert.ConversionError, match="library.blend.*Make Local"):
+        convert.principled_to_rt_lit(mat, factory)
+    assert _snapshot_tree(mat.node_tree) == before

@@ -9,15 +9,6 @@ import pytest
 pytestmark = pytest.mark.blender
 
 
-@pytest.fixture
-def registered(bpy_module):
-    from rt_lookdev import addon
-
-    addon.register()
-    yield bpy_module
-    addon.unregister()
-
-
 def test_export_luts_operator(registered, empty_scene, tmp_path):
     bpy = registered
     out = tmp_path / "engine_luts"

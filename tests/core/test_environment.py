@@ -281,3 +281,36 @@ def test_bake_is_cached(tmp_path, monkeypatch):
     assert other.states == {"sh": "cached", "prefiltered": "baked"}
     _write_exr(src, rng.random((32, 64, 3)))
     assert pf.bake_environment(src, out, SMALL).states == {"sh": "baked", "prefiltered": "baked"}
+
+
+def test_a_one_texel_world_bakes_as_a_constant(tmp_path):
+    """A 1 x 1 equirect image is a constant world: its SH is that constant alone, its levels the constant."""
+    from rt_lookdev.core.environment import prefilter as pf
+
+    image = np.array([[[0.5, 0.25, 2.0]]], np.float32)
+    bake = pf.bake_environment_image(image, "one", "test", tmp_path, pf.PrefilterSettings(16, 8, (0.0, 1.0)),
+                                     progress=lambda *a: None)
+    coeffs = np.asarray(bake.sh_image, np.float64)[:, :3]
+    assert np.allclose(coeffs[0] / (2.0 * np.sqrt(np.pi)), image[0, 0], rtol=1e-5)
+    assert np.abs(coeffs[1:]).max() < 1e-5
+
+
+def test_an_interrupted_world_bake_leaves_no_partial_file(tmp_path):
+    """Interrupted while prefiltering: no partial (.tmp) file; the SH file already written is whole and
+    current, so the next bake reuses it and computes only the prefiltered levels."""
+    from rt_lookdev.core.environment import prefilter as pf
+
+    image = np.random.default_rng(4).uniform(0.1, 3.0, (16, 32, 3)).astype(np.float32)
+    settings = pf.PrefilterSettings(16, 8, (0.0, 0.5, 1.0))
+
+    def interrupt(stage, done, total):
+        if stage == "prefiltered" and done > 0:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        pf.bake_environment_image(image, "env", "test", tmp_path, settings, progress=interrupt)
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert not [n for n in names if n.endswith(".tmp")]
+    assert "env_ggx_prefiltered.exr" not in names and "env_sh.exr" in names
+    bake = pf.bake_environment_image(image, "env", "test", tmp_path, settings, progress=lambda *a: None)
+    assert bake.states == {"sh": "cached", "prefiltered": "baked"}

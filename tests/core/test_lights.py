@@ -102,7 +102,7 @@ def test_interfaces_are_the_driver_values():
     col = [f"Color {c}" for c in "RGB"]
     expect = {
         "RTL Area Light Quad": (loc + rot + scl + ["Power"] + col + ["Size", "Size Y"],
-                                ["p0", "p1", "p2", "p3", "Radiance"]),
+                                ["p0", "p1", "p2", "p3", "Center", "Radiance"]),
         "RTL Area Light Disk": (loc + rot + scl + ["Power"] + col + ["Size", "Size Y"],
                                 ["Center", "Axis U", "Axis V", "Radiance"]),
         "RTL Point Light": (loc + ["Power"] + col + ["Position"], ["L", "Irradiance"]),

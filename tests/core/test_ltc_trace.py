@@ -108,7 +108,7 @@ def test_integral_functions_are_small_node_groups():
         assert list(fn.output_sockets) == ["Integral"]
         assert all(s.description for s in list(fn.input_sockets.values()) + list(fn.output_sockets.values()))
     assert list(polygon.LTC_QUAD_INTEGRAL.input_sockets) == ["c0", "c1", "c2", "c3", "p0", "p1", "p2", "p3",
-                                                              "Two Sided"]
+                                                              "Center", "Two Sided"]
     assert list(disk.LTC_DISK_INTEGRAL.input_sockets) == ["c0", "c1", "c2", "c3", "Center", "Axis U", "Axis V",
                                                            "Two Sided"]
 
@@ -136,12 +136,13 @@ def test_quad_integral_traced_equals_numpy(tables, dtype):
     cfg = _configurations()
     corners = np.stack([_quad(c, u, v) for c, u, v in zip(cfg["c"], cfg["u"], cfg["w"])])
     names = dict({f"c{i}": "float" for i in range(4)}, **{f"p{i}": "vector" for i in range(4)},
-                 **{"Two Sided": "float"})
+                 **{"Center": "vector", "Two Sided": "float"})
     _, out = trace(lambda **kw: polygon.LTC_QUAD_INTEGRAL(tables, **kw)["Integral"], names)
     for packed in _packed_cases(tables, cfg):
         for two in (0.0, 1.0):
             args = {f"c{i}": packed[:, i] for i in range(4)}
             args.update({f"p{i}": corners[:, i] for i in range(4)}, **{"Two Sided": np.full(len(packed), two)})
+            args["Center"] = corners.mean(axis=1)
             direct = polygon.LTC_QUAD_INTEGRAL(tables, **args)["Integral"]
             # the array API (3x3 Minv) is the same computation
             via_matrix = polygon.ltc_quad_integral(matrix.unpack_inverse(packed), corners, bool(two),

@@ -193,3 +193,51 @@ def test_inputs_hash_sees_code_not_comments(tmp_path):
     assert catalog.code_text(a) == base
     a.write_text(src.replace("x * 2", "x * 3"))
     assert catalog.code_text(a) != base
+
+
+def _quick_compute(monkeypatch, during=None):
+    """Replace the bake's computation by constant tables of the right shapes (the write path is under
+    test, not the integrals); ``during(group)`` runs while a group is "computed"."""
+    def compute(name, progress=None):
+        if during is not None:
+            during(name)
+        return {s.name: np.full(s.shape + (4,), 0.5, np.float32) for s in catalog.TABLES.values() if s.group == name}
+
+    monkeypatch.setattr(bake, "_compute", compute)
+
+
+def test_a_failed_write_keeps_the_previous_tables_and_names_the_fix(tmp_path, monkeypatch):
+    """A LUT folder that cannot be written (read-only, full, gone): LutWriteError naming the file, the cause
+    and the way out; the group's previous files stay byte-identical and no partial (.tmp) file is left."""
+    _quick_compute(monkeypatch)
+    bake.bake(tmp_path, groups=["ggx_energy"], workers=1, log=lambda line: None)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    assert len(before) >= 2
+    calls = []
+    real = exr_io._write_exr
+
+    def failing(path, channels, attributes):
+        calls.append(path)
+        if len(calls) == 2:                   # the group's second table: the first is already written
+            raise PermissionError(13, "Permission denied", str(path))
+        real(path, channels, attributes)
+
+    monkeypatch.setattr(exr_io, "_write_exr", failing)
+    with pytest.raises(exr_io.LutWriteError, match=r"Permission denied.*--lut-dir"):
+        bake.bake(tmp_path, force=True, groups=["ggx_energy"], workers=1, log=lambda line: None)
+    assert len(calls) == 2
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_a_lut_folder_removed_during_a_bake_is_recreated_whole(tmp_path, monkeypatch):
+    """The folder vanishes while a group is computed: the bake writes the whole group again, with metadata
+    that reads back as current."""
+    import shutil
+
+    folder = tmp_path / "luts"
+    folder.mkdir()
+    _quick_compute(monkeypatch, during=lambda name: shutil.rmtree(folder, ignore_errors=True))
+    bake.bake(folder, groups=["ggx_energy"], workers=1, log=lambda line: None)
+    specs = [s for s in catalog.TABLES.values() if s.group == "ggx_energy"]
+    assert sorted(p.name for p in folder.iterdir()) == sorted(s.filename for s in specs)
+    assert bake.group_is_current("ggx_energy", folder)

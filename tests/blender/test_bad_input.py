@@ -1,0 +1,190 @@
+"""Bad input end to end (docs/robustness.md, "Bad input"): what the user sees and what is kept, for the cases
+not covered next to their features: scenes with 0 and 100 lights, lights linked from a library, register /
+unregister x 50, undo and redo after Convert, Sync Lights and Sync World, 1 x 1 and tiny world images."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.blender
+
+
+def _reports(capfd):
+    return capfd.readouterr().out + capfd.readouterr().err
+
+
+def _point_light(bpy, scene, name, location):
+    obj = bpy.data.objects.new(name, bpy.data.lights.new(name, "POINT"))
+    obj.location = location
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def _rt_lit_object(bpy, scene, lut_dir, features=None):
+    from rt_lookdev.addon import compat, materials
+
+    mat = compat.new_material("Lookdev")
+    materials.assign_rt_lit(mat, features, scene, lut_dir)
+    mesh = bpy.data.meshes.new("ball")
+    obj = bpy.data.objects.new("ball", mesh)
+    obj.data.materials.append(mat)
+    scene.collection.objects.link(obj)
+    return mat
+
+
+def _light_terms(bpy):
+    """Light kinds of the RT Lit groups' last build: the lights each group shades."""
+    from rt_lookdev.addon import materials
+
+    return materials.synced_light_kinds()
+
+
+def test_sync_lights_with_no_lights_and_with_a_hundred(registered, empty_scene, lut_dir, capfd):
+    """0 lights: a valid material with no light terms, said so.  100 lights: built, with a warning naming the
+    Cycles budget and where the capacities are measured; nothing else changes."""
+    bpy = registered
+    scene = empty_scene
+    mat = _rt_lit_object(bpy, scene, lut_dir)
+    assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
+    out = _reports(capfd)
+    assert "RT Lit: 0 lights [none]" in out
+    assert _light_terms(bpy) == []
+    for i in range(100):
+        _point_light(bpy, scene, f"Light {i:03d}", (i * 0.1, 2.0, 3.0))
+    assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
+    out = _reports(capfd)
+    assert "RT Lit: 100 lights [100 point]" in out      # counted per kind: a list of 100 names was truncated
+    assert "Cycles may fail to compile" in out and "docs/benchmarks/rt_lit.md" in out and "truncated" not in out
+    assert len(_light_terms(bpy)) == 100
+    assert mat.node_tree.nodes.get("RT Lit") is not None or any(n.bl_idname == "ShaderNodeGroup"
+                                                                   for n in mat.node_tree.nodes)
+
+
+def test_lights_linked_from_a_library_are_shaded(registered, empty_scene, relink_from_library):
+    """A light object linked from another .blend (a studio rig kept in a library) is shaded like a local one."""
+    from rt_lookdev.addon.materials import scene_lights
+
+    bpy = registered
+    _point_light(bpy, empty_scene, "Rig Key", (1.0, 2.0, 3.0))
+    empty_scene.collection.objects.link(relink_from_library("objects", "Rig Key"))
+    assert [(o.name, kind) for o, kind in scene_lights(empty_scene)] == [("Rig Key", "point")]
+    assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
+
+
+def test_register_unregister_fifty_times_leaves_nothing(bpy_module, empty_scene):
+    """50 register / unregister cycles: the same types, operators, menus and handlers as before."""
+    import rt_lookdev
+
+    def state():
+        menus = {name: len(getattr(bpy_module.types, name).draw._draw_funcs)
+                 for name in ("TOPBAR_MT_file_export", "VIEW3D_MT_object")
+                 if hasattr(getattr(bpy_module.types, name, None), "draw")
+                 and hasattr(getattr(bpy_module.types, name).draw, "_draw_funcs")}
+        handlers = {name: len(getattr(bpy_module.app.handlers, name)) for name in dir(bpy_module.app.handlers)
+                    if not name.startswith("_") and isinstance(getattr(bpy_module.app.handlers, name), list)}
+        return set(dir(bpy_module.types)), set(dir(bpy_module.ops.rtl)), menus, handlers
+
+    before = state()
+    for _ in range(50):
+        rt_lookdev.register()
+        rt_lookdev.unregister()
+    assert state() == before
+
+
+def test_undo_and_redo_convert_and_sync_lights(registered, empty_scene, lut_dir):
+    """Undo after Convert gives the Principled material back; redo the RT Lit one.  Undo after Sync Lights
+    gives the groups of the previous light set back."""
+    from rt_lookdev.addon import compat, convert
+
+    bpy = registered
+    scene = empty_scene
+    mat = compat.new_material("Undoable")
+    mesh = bpy.data.meshes.new("ball")
+    obj = bpy.data.objects.new("ball", mesh)
+    obj.data.materials.append(mat)
+    scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.ed.undo_push(message="before convert")
+    # ('EXEC_DEFAULT', True): run as from the interface, which pushes the operator's undo step
+    assert bpy.ops.rtl.convert_to_rt_lit('EXEC_DEFAULT', True, target='ACTIVE') == {'FINISHED'}
+    assert convert.is_rt_lit_material(bpy.data.materials["Undoable"])
+    bpy.ops.ed.undo()
+    assert not convert.is_rt_lit_material(bpy.data.materials["Undoable"])
+    bpy.ops.ed.redo()
+    assert convert.is_rt_lit_material(bpy.data.materials["Undoable"])
+
+    bpy.ops.ed.undo_push(message="before sync")
+    _point_light(bpy, bpy.context.scene, "Key", (1.0, 1.0, 2.0))
+    bpy.ops.ed.undo_push(message="light added")
+    assert bpy.ops.rtl.sync_lights('EXEC_DEFAULT', True) == {'FINISHED'}
+    assert len(_light_terms(bpy)) == 1
+    bpy.ops.ed.undo()
+    assert len(_light_terms(bpy)) == 0
+    bpy.ops.ed.redo()
+    assert len(_light_terms(bpy)) == 1
+
+
+@pytest.mark.parametrize("size", [(1, 1), (2, 1), (4, 2)])
+def test_tiny_world_images_bake_and_shade(bpy_module, empty_scene, tmp_path, monkeypatch, size):
+    """A 1 x 1 (or 2 x 1, 4 x 2) environment image is a constant (or nearly) world: it bakes, its SH is its
+    radiance, and its prefiltered levels are finite."""
+    from rt_lookdev.addon import compat
+    from rt_lookdev.addon import world_sync as world
+    from rt_lookdev.core.environment.prefilter import PrefilterSettings
+
+    monkeypatch.setenv(world.CACHE_ENV, str(tmp_path / "env-cache"))
+    bpy = bpy_module
+    w, h = size
+    img = bpy.data.images.new("tiny", w, h, alpha=True, float_buffer=True)
+    img.pixels.foreach_set(np.tile([0.5, 0.25, 2.0, 1.0], w * h).astype(np.float32))
+    wd = compat.new_world("World")
+    empty_scene.world = wd
+    env = wd.node_tree.nodes.new("ShaderNodeTexEnvironment")
+    env.image = img
+    wd.node_tree.links.new(env.outputs["Color"], wd.node_tree.nodes["Background"].inputs["Color"])
+    try:
+        setup = world.world_setup(wd)
+        assert setup.usable, setup.reason
+        bake = world.bake_world(empty_scene, settings=PrefilterSettings(16, 8, (0.0, 0.5, 1.0)))
+        coeffs = np.asarray(bake.sh_image, np.float64)[:, :3]
+        assert np.allclose(coeffs[0] * 0.28209479177387814, (0.5, 0.25, 2.0), rtol=1e-4)   # Y00 = 1/(2 sqrt(pi))
+        assert np.allclose(coeffs[1:], 0.0, atol=1e-4)
+        from rt_lookdev.core.lut import exr_io
+
+        levels, _ = exr_io.read_table(bake.prefiltered_path)
+        assert np.isfinite(levels).all() and np.allclose(levels[..., :3], (0.5, 0.25, 2.0), rtol=1e-3)
+        assert world.sync_world(empty_scene, bake=bake) is not None
+    finally:
+        world.remove_world_group()
+
+
+def test_undo_and_redo_sync_world(registered, empty_scene, tmp_path, monkeypatch):
+    """Undo after Sync World removes the "RTL World" group it built; redo brings it back."""
+    from rt_lookdev.addon import compat
+    from rt_lookdev.addon import world_sync as world
+    from rt_lookdev.core.environment import prefilter
+
+    bpy = registered
+    monkeypatch.setenv(world.CACHE_ENV, str(tmp_path / "env-cache"))
+    real = prefilter.PrefilterSettings
+    small = real(16, 8, (0.0, 0.5, 1.0))
+    # the operator bakes with the default settings: keep them small here
+    monkeypatch.setattr(prefilter, "PrefilterSettings", lambda *a, **k: real(*a, **k) if a or k else small)
+    img = bpy.data.images.new("env", 8, 4, alpha=True, float_buffer=True)
+    img.pixels.foreach_set(np.random.default_rng(1).uniform(0.1, 2.0, 8 * 4 * 4).astype(np.float32))
+    wd = compat.new_world("World")
+    empty_scene.world = wd
+    env = wd.node_tree.nodes.new("ShaderNodeTexEnvironment")
+    env.image = img
+    wd.node_tree.links.new(env.outputs["Color"], wd.node_tree.nodes["Background"].inputs["Color"])
+    bpy.ops.ed.undo_push(message="before sync world")
+    try:
+        assert bpy.ops.rtl.sync_world('EXEC_DEFAULT', True) == {'FINISHED'}
+        assert world.WORLD_GROUP in bpy.data.node_groups
+        bpy.ops.ed.undo()
+        assert world.WORLD_GROUP not in bpy.data.node_groups
+        bpy.ops.ed.redo()
+        assert world.WORLD_GROUP in bpy.data.node_groups
+    finally:
+        world.remove_world_group()
