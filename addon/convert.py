@@ -295,6 +295,19 @@ def ignored_principled_inputs(node):
     return tuple(ignored)
 
 
+def principled_uses_sheen(material):
+    """Whether ``material``'s Principled BSDF (feeding its active output) has sheen: Sheen Weight > 0 or
+    linked.  The Convert dialog turns the sheen switch on for it."""
+    if material is None or material.node_tree is None:
+        return False
+    output = _active_output(material.node_tree)
+    node = _source_node(output.inputs["Surface"]) if output is not None else None
+    if node is None or node.bl_idname != "ShaderNodeBsdfPrincipled":
+        return False
+    sheen = node.inputs["Sheen Weight"]
+    return bool(sheen.is_linked or sheen.default_value > 0.0)
+
+
 def stored_features(material):
     """The features remembered on the material, or None."""
     data = material.get(FEATURES_KEY) if material is not None else None
@@ -479,6 +492,11 @@ def principled_to_rt_lit(material, group_factory, features=None):
 
     _store_features(material, features)
     result = ConversionResult(material.name, "converted", ignored_inputs=ignored, features=features)
+    sheen = principled.inputs["Sheen Weight"]
+    if not features.sheen and (sheen.is_linked or sheen.default_value > 0.0):
+        amount = "a linked Sheen Weight" if sheen.is_linked else f"Sheen Weight {sheen.default_value:.3g}"
+        result.warnings.append(f"Material '{material.name}': {amount} is not shaded because the sheen switch is "
+                               "off; convert again with Sheen on to keep it")
     if ignored:
         result.warnings.append(
             f"Material '{material.name}': RT Lit ignores the Principled inputs "
@@ -658,11 +676,14 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
                         environment_ms=self.environment_ms)
 
     def invoke(self, context, event):
-        stored = stored_features(_active_material(context))
+        material = _active_material(context)
+        stored = stored_features(material)
         if stored is not None:
             self.specular, self.diffuse = stored.specular, stored.diffuse
             self.sheen, self.cloth = stored.sheen, stored.cloth
             self.environment_ms = stored.environment_ms
+        else:
+            self.sheen = self.sheen or principled_uses_sheen(material)
         return context.window_manager.invoke_props_dialog(self)
 
     def draw(self, context):

@@ -15,6 +15,8 @@
 """
 from __future__ import annotations
 
+import math
+
 import bpy
 
 from ..core import lights as core_lights
@@ -41,6 +43,30 @@ def light_kind(obj):
     if data.type == "AREA":
         return _AREA_SHAPES.get(data.shape)
     return {"POINT": "point", "SPOT": "spot", "SUN": "sun"}.get(data.type)
+
+
+#: Sun angles below this are shaded as 0 without a word (Blender's default sun is 0.53 degrees).
+SUN_ANGLE_REPORTED = math.radians(1.0)
+
+
+def ignored_light_settings(obj, kind):
+    """The settings of a light RT Lit does not shade (core/lights.py: radius-0 point and spot lights, an
+    angle-0 sun, no exposure, temperature or spread), as short phrases: ["radius 0.1 m", ...]."""
+    data = obj.data
+    out = []
+    if abs(getattr(data, "exposure", 0.0)) > 0.0:
+        out.append(f"exposure {data.exposure:+g}")
+    if getattr(data, "use_temperature", False):
+        out.append(f"temperature {data.temperature:g} K")
+    if not getattr(data, "normalize", True):
+        out.append("Normalize off")
+    if kind in ("quad", "disk") and getattr(data, "spread", math.pi) < math.pi - 1e-6:
+        out.append(f"spread {math.degrees(data.spread):.0f} deg")
+    if kind in ("point", "spot") and data.shadow_soft_size > 0.0:
+        out.append(f"radius {data.shadow_soft_size:g} m")
+    if kind == "sun" and data.angle > SUN_ANGLE_REPORTED:
+        out.append(f"angle {math.degrees(data.angle):.1f} deg")
+    return out
 
 
 def is_rendered(scene, obj):

@@ -91,13 +91,6 @@ class RTL_OT_lut_status(bpy.types.Operator):
         return {'FINISHED'}
 
 
-#: Area lights an RT Lit material can shade in Cycles with typical switches (measured:
-#: scripts/benchmark_rt_lit.py; 8 for Kulla-Conty, 3 with every technique on; one less of each
-#: with the World term: 7 for Kulla-Conty, 8 with sheen or cloth).
-CYCLES_LIGHT_BUDGET = 8
-CYCLES_LIGHT_BUDGET_WITH_WORLD = 7
-
-
 #: Up to this many lights the Sync Lights report names each; beyond, it counts them per kind (Blender
 #: truncates long reports, which cut off the warning after a list of 100 names).
 NAMED_LIGHTS_MAX = 8
@@ -113,6 +106,39 @@ def _light_summary(records):
     for _, kind in records:
         counts[kind] = counts.get(kind, 0) + 1
     return ", ".join(f"{n} {kind}" for kind, n in sorted(counts.items(), key=lambda kv: -kv[1]))
+
+
+#: At most this many lights are named in the "not shaded" part of the report.
+IGNORED_LIGHTS_NAMED = 4
+
+
+def _ignored_settings(records, materials):
+    """"Key (radius 0.1 m), Sun (angle 5.0 deg)": the light settings RT Lit does not shade, a few lights."""
+    parts = [f"{obj.name} ({', '.join(found)})" for obj, kind in records
+             if (found := materials.ignored_light_settings(obj, kind))]
+    if len(parts) > IGNORED_LIGHTS_NAMED:
+        parts = parts[:IGNORED_LIGHTS_NAMED] + [f"{len(parts) - IGNORED_LIGHTS_NAMED} more lights"]
+    return ", ".join(parts)
+
+
+def _over_capacity(groups, lights, has_world):
+    """The warning for RT Lit groups whose feature set shades fewer lights in Cycles than the scene has
+    (core/materials/cycles_capacity.py: measured SVM-stack capacity), or ""."""
+    from ..core.materials import cycles_capacity
+    from ..core.materials.rt_lit_interface import Features
+    from .common import FEATURES_KEY
+
+    over = []
+    for ng in groups:
+        features = Features.from_dict(ng[FEATURES_KEY])
+        capacity, measured = cycles_capacity.light_capacity(features, has_world)
+        if lights > capacity:
+            over.append(f"({features.label()}) {'at most' if measured else 'about'} {capacity}")
+    if not over:
+        return ""
+    return (f"Cycles renders RT Lit materials black beyond their shader-stack capacity, "
+            f"{'with' if has_world else 'without'} the World term: {'; '.join(over)} lights "
+            f"(docs/benchmarks/rt_lit.md); EEVEE has no such limit")
 
 
 class RTL_OT_sync_lights(bpy.types.Operator):
@@ -137,16 +163,13 @@ class RTL_OT_sync_lights(bpy.types.Operator):
         except Exception as ex:
             self.report({'ERROR'}, f"Could not sync lights: {ex}")
             return {'CANCELLED'}
-        kinds = _light_summary(records)
-        message = f"RT Lit: {len(records)} lights [{kinds}]; {len(groups)} RT Lit groups rebuilt"
-        has_world = WORLD_GROUP in bpy.data.node_groups
-        budget = CYCLES_LIGHT_BUDGET_WITH_WORLD if has_world else CYCLES_LIGHT_BUDGET
-        if len(records) > budget:
-            # Cycles' SVM stack (255 floats per material) limits the lights one material can shade
-            self.report({'WARNING'}, f"{message}. Cycles may fail to compile RT Lit materials with more than "
-                                     f"{budget} lights{' and the World term' if has_world else ''} "
-                                     "(3 with every technique on; "
-                                     "docs/benchmarks/rt_lit.md); EEVEE has no such limit")
+        message = f"RT Lit: {len(records)} lights [{_light_summary(records)}]; {len(groups)} RT Lit groups rebuilt"
+        ignored = _ignored_settings(records, materials)
+        if ignored:
+            message += f"; not shaded: {ignored}"
+        over = _over_capacity(groups, len(records), WORLD_GROUP in bpy.data.node_groups)
+        if over:
+            self.report({'WARNING'}, f"{message}. {over}")
         else:
             self.report({'INFO'}, message)
         return {'FINISHED'}

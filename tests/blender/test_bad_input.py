@@ -54,7 +54,9 @@ def test_sync_lights_with_no_lights_and_with_a_hundred(registered, empty_scene, 
     assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
     out = _reports(capfd)
     assert "RT Lit: 100 lights [100 point]" in out      # counted per kind: a list of 100 names was truncated
-    assert "Cycles may fail to compile" in out and "docs/benchmarks/rt_lit.md" in out and "truncated" not in out
+    # the default switches (turquin, cod) shade at most 13 lights in Cycles (measured)
+    assert "black beyond their shader-stack capacity" in out and "(turquin, cod) at most 13" in out
+    assert "docs/benchmarks/rt_lit.md" in out and "truncated" not in out
     assert len(_light_terms(bpy)) == 100
     assert mat.node_tree.nodes.get("RT Lit") is not None or any(n.bl_idname == "ShaderNodeGroup"
                                                                    for n in mat.node_tree.nodes)
@@ -188,3 +190,28 @@ def test_undo_and_redo_sync_world(registered, empty_scene, tmp_path, monkeypatch
         assert world.WORLD_GROUP in bpy.data.node_groups
     finally:
         world.remove_world_group()
+
+
+def test_sync_lights_names_what_is_not_shaded_and_the_capacity_of_each_feature_set(registered, empty_scene,
+                                                                                    lut_dir, capfd):
+    """The Sync report says which light settings RT Lit ignores, and warns with the measured capacity of each
+    material's switches (3 lights with every technique on), not a fixed number."""
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    bpy = registered
+    scene = empty_scene
+    _rt_lit_object(bpy, scene, lut_dir, Features("kulla_conty", "wrapped", sheen=True, cloth=True))
+    _rt_lit_object(bpy, scene, lut_dir, Features("single", "lambert"))
+    key = _point_light(bpy, scene, "Key", (1.0, 2.0, 3.0))
+    key.data.shadow_soft_size = 0.1
+    key.data.exposure = 1.0
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.angle = 0.1
+    scene.collection.objects.link(sun)
+    for i in range(2):
+        _point_light(bpy, scene, f"Fill {i}", (i, -2.0, 3.0))
+    assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
+    out = _reports(capfd)
+    assert "not shaded: Key (exposure +1, radius 0.1 m), Sun (angle 5.7 deg)" in out
+    assert "(kulla-conty, wrapped, sheen, cloth) at most 3 lights" in out
+    assert "(single, lambert)" not in out.split("capacity")[-1]       # 4 lights are within its 15

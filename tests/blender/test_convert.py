@@ -452,3 +452,15 @@ def test_linked_material_is_refused_with_the_fix(bpy_module, convert, factory, r
     with pytest.raises(convert.ConversionError, match="library.blend.*Make Local"):
         convert.principled_to_rt_lit(mat, factory)
     assert _snapshot_tree(mat.node_tree) == before
+
+
+def test_sheen_off_with_a_sheen_material_says_so(bpy_module, convert, factory):
+    """A Principled material with sheen: the dialog proposes Sheen on; converting with it off warns that the
+    sheen is not shaded (it used to vanish silently)."""
+    mat = _principled_material(bpy_module, "Velvet")          # EDITED: Sheen Weight 0.4
+    assert convert.principled_uses_sheen(mat)
+    result = convert.principled_to_rt_lit(mat, factory, Features(sheen=False))
+    assert any("Sheen Weight 0.4 is not shaded" in w and "Sheen on" in w for w in result.warnings)
+    plain = _new_material(bpy_module, "Plain")
+    assert not convert.principled_uses_sheen(plain)
+    assert not any("Sheen" in w for w in convert.principled_to_rt_lit(plain, factory, Features()).warnings)

@@ -314,3 +314,18 @@ def test_an_interrupted_world_bake_leaves_no_partial_file(tmp_path):
     assert "env_ggx_prefiltered.exr" not in names and "env_sh.exr" in names
     bake = pf.bake_environment_image(image, "env", "test", tmp_path, settings, progress=lambda *a: None)
     assert bake.states == {"sh": "cached", "prefiltered": "baked"}
+
+
+def test_readme_bake_environment_commands(tmp_path):
+    """The README's `python scripts/bake_environment.py --list` and `--hdri studio` (small here)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[2] / "scripts" / "bake_environment.py"
+    listed = subprocess.run([sys.executable, str(script), "--list"], capture_output=True, text=True, timeout=120)
+    assert listed.returncode == 0 and "studio:" in listed.stdout, listed.stderr
+    baked = subprocess.run([sys.executable, str(script), "--hdri", "studio", "--out", str(tmp_path), "--width", "32",
+                            "--height", "16"], capture_output=True, text=True, timeout=300)
+    assert baked.returncode == 0, baked.stderr
+    assert (tmp_path / "studio_sh.exr").is_file() and (tmp_path / "studio_ggx_prefiltered.exr").is_file()

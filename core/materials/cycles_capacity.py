@@ -1,0 +1,45 @@
+"""How many lights one RT Lit material can shade in Cycles before its shader runs out of SVM stack.
+
+Cycles' SVM keeps every live value of a material on a stack of 255 floats; an RT Lit material carries
+each light's terms, so past a number of lights that depends on its switches the compile fails and the
+surface renders black.  The numbers are measured by ``scripts/benchmark_rt_lit.py`` (quad lights, the
+costliest kind; docs/benchmarks/rt_lit.md, "Capacity") and checked against its JSON by
+tests/core/test_cycles_capacity.py.  EEVEE has no such limit.
+"""
+from __future__ import annotations
+
+from .rt_lit_interface import Features
+
+#: feature set -> (max quad lights, max quad lights with the World term), measured.
+MEASURED = {
+    Features("single", "lambert"): (15, 15),
+    Features("turquin", "cod"): (13, 13),
+    Features("fdez_aguera", "lambert"): (15, 14),
+    Features("kulla_conty", "lambert"): (8, 7),
+    Features("turquin", "cod", sheen=True): (10, 8),
+    Features("single", "cod", cloth=True): (10, 8),
+    Features("kulla_conty", "wrapped", sheen=True, cloth=True): (3, 3),
+}
+
+# Rough cost order of the switches, for feature sets that were not measured: a measured set at least as
+# costly in every switch bounds the capacity from below.
+_SPECULAR_COST = {"single": 0, "turquin": 1, "fdez_aguera": 1, "kulla_conty": 2}
+_DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1}
+
+
+def _at_least_as_costly(measured, features):
+    return (_SPECULAR_COST[measured.specular] >= _SPECULAR_COST[features.specular]
+            and _DIFFUSE_COST[measured.diffuse] >= _DIFFUSE_COST[features.diffuse]
+            and measured.sheen >= features.sheen and measured.cloth >= features.cloth)
+
+
+def light_capacity(features, world=False):
+    """(lights, measured): the most lights a material with ``features`` shades in Cycles; ``measured`` is
+    False when the set was not measured and the number is the bound from a costlier measured set (or the
+    smallest measured capacity)."""
+    column = 1 if world else 0
+    key = Features(features.specular, features.diffuse, features.sheen, features.cloth)
+    if key in MEASURED:
+        return MEASURED[key][column], True
+    bounds = [caps[column] for measured, caps in MEASURED.items() if _at_least_as_costly(measured, key)]
+    return (max(bounds) if bounds else min(caps[column] for caps in MEASURED.values())), False

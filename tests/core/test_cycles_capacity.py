@@ -1,0 +1,31 @@
+"""The Cycles light capacities the add-on warns with are the measured ones (docs/benchmarks/rt_lit.json)."""
+import json
+from pathlib import Path
+
+from rt_lookdev.core.materials import cycles_capacity
+from rt_lookdev.core.materials.rt_lit_interface import Features
+
+BENCHMARK = Path(__file__).resolve().parents[2] / "docs" / "benchmarks" / "rt_lit.json"
+
+
+def _features(label):
+    parts = [p.strip() for p in label.split(",")]
+    return Features(parts[0].replace("-", "_"), parts[1], sheen="sheen" in parts[2:], cloth="cloth" in parts[2:])
+
+
+def test_table_is_the_benchmarks_measurement():
+    rows = json.loads(BENCHMARK.read_text())["rows"]
+    measured = {_features(r["features"]): (r["max_quad_lights"], r["world_max_quad_lights"]) for r in rows}
+    assert measured == cycles_capacity.MEASURED
+
+
+def test_unmeasured_sets_get_a_costlier_measured_bound():
+    assert cycles_capacity.light_capacity(Features("kulla_conty", "lambert")) == (8, True)
+    assert cycles_capacity.light_capacity(Features("kulla_conty", "lambert"), world=True) == (7, True)
+    # turquin + lambert: the best bound among sets at least as costly is fdez-aguera + lambert's 15
+    assert cycles_capacity.light_capacity(Features("turquin", "lambert")) == (15, False)
+    # turquin + lambert + cloth: only the all-on set is at least as costly (single + cod + cloth has a cheaper
+    # specular): the warning errs on the safe side
+    assert cycles_capacity.light_capacity(Features("turquin", "lambert", cloth=True)) == (3, False)
+    # everything on but CoD instead of wrapped: the all-on row bounds it
+    assert cycles_capacity.light_capacity(Features("kulla_conty", "cod", sheen=True, cloth=True)) == (3, False)
