@@ -1,9 +1,9 @@
 """A small OpenEXR reader for the LUT files this project writes, in pure Python + numpy.
 
 Blender's bundled Python has no ``OpenEXR`` module, so the add-on reads its tables with
-this when that import fails.  It supports exactly what ``exr_io.write_table`` produces and
-refuses anything else with a clear error: single-part scanline images, NO or ZIP(S)
-compression, FLOAT (32-bit) or HALF (16-bit) channels (all of one type), x/y sampling 1.  Attributes of type string, int,
+this when that import fails.  It supports what ``exr_io.write_table`` produces and Blender's own
+scanline renders, and refuses anything else with a clear error: scanline images (single-part, or
+multi-part as Blender's multilayer renders are), NO or ZIP(S) compression, FLOAT (32-bit) or HALF (16-bit) channels (all of one type), x/y sampling 1.  Attributes of type string, int,
 float and double are decoded; others are kept as raw bytes.
 
 Format: OpenEXR file layout (openexr.com, "OpenEXR File Layout"): magic 20000630, version
@@ -76,16 +76,9 @@ def _unzip(data, expected):
     return out.tobytes()
 
 
-def read(path):
-    """Return (attributes dict, {channel name: (H, W) float32 array, top row first})."""
-    with open(path, "rb") as f:
-        data = f.read()
-    if len(data) < 8 or struct.unpack_from("<i", data, 0)[0] != MAGIC:
-        raise ExrFormatError("not an OpenEXR file (bad magic number)")
-    version = struct.unpack_from("<i", data, 4)[0]
-    if version & 0xFF != 2 or version & 0x1A00:   # tiled / multi-part / deep bits
-        raise ExrFormatError(f"unsupported EXR flavour (version word {version:#x})")
-    pos, attrs, types = 8, {}, {}
+def _read_header(data, pos):
+    """(attributes, types, position after the header's terminating \\0) of one header."""
+    attrs, types = {}, {}
     while data[pos:pos + 1] != b"\0":
         name, pos = _cstring(data, pos)
         type_name, pos = _cstring(data, pos)
@@ -94,24 +87,33 @@ def read(path):
         attrs[name] = _decode_attribute(type_name, data[pos:pos + size])
         types[name] = type_name
         pos += size
-    pos += 1
+    return attrs, types, pos + 1
+
+
+def _layout(attrs):
+    """(x0, y0, x1, y1, channels, dtype, lines per chunk, chunks) of one part, checked."""
     compression = attrs.get("compression")
     if compression not in _LINES_PER_CHUNK:
         raise ExrFormatError(f"unsupported compression {compression}")
     x0, y0, x1, y1 = attrs["dataWindow"]
-    width, height = x1 - x0 + 1, y1 - y0 + 1
     channels = sorted(attrs["channels"])
     types_used = {pixel_type for _, pixel_type, _, _ in channels}
     for name, pixel_type, xs, ys in channels:
         if pixel_type not in _DTYPES or xs != 1 or ys != 1 or len(types_used) != 1:
             raise ExrFormatError(f"channel {name}: only unsubsampled 32-bit or 16-bit float channels, all of one "
                                  "type, are supported")
-    dtype = np.dtype(_DTYPES[types_used.pop()])
     lines = _LINES_PER_CHUNK[compression]
-    n_chunks = (height + lines - 1) // lines
-    offsets = struct.unpack_from(f"<{n_chunks}Q", data, pos)
-    planes = {name: np.empty((height, width), dtype="<f4") for name, *_ in channels}
+    return x0, y0, x1, y1, channels, np.dtype(_DTYPES[types_used.pop()]), lines, (y1 - y0 + lines) // lines
+
+
+def _read_part(data, offsets, layout, compression, multipart, planes):
+    x0, y0, x1, y1, channels, dtype, lines, _ = layout
+    width = x1 - x0 + 1
+    for name, *_ in channels:
+        planes[name] = np.empty((y1 - y0 + 1, width), dtype="<f4")
     for offset in offsets:
+        if multipart:                      # each chunk starts with its part number
+            offset += 4
         y, size = struct.unpack_from("<ii", data, offset)
         chunk = data[offset + 8:offset + 8 + size]
         rows = min(lines, y1 + 1 - y)
@@ -123,5 +125,33 @@ def read(path):
         block = np.frombuffer(chunk, dtype=dtype).reshape(rows, len(channels), width)
         for c, (name, *_) in enumerate(channels):
             planes[name][y - y0:y - y0 + rows] = block[:, c]
-    attrs["channels"] = [name for name, *_ in channels]
+
+
+def read(path):
+    """Return (attributes dict, {channel name: (H, W) float32 array, top row first}).  A multi-part file
+    (Blender's multilayer renders) gives the channels of every part and the first part's attributes."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if len(data) < 8 or struct.unpack_from("<i", data, 0)[0] != MAGIC:
+        raise ExrFormatError("not an OpenEXR file (bad magic number)")
+    version = struct.unpack_from("<i", data, 4)[0]
+    if version & 0xFF != 2 or version & 0xA00:   # tiled / deep bits (0x400 long names, 0x1000 multi-part: read)
+        raise ExrFormatError(f"unsupported EXR flavour (version word {version:#x})")
+    multipart = bool(version & 0x1000)
+    headers, pos = [], 8
+    while True:                           # multi-part: headers, then an empty one (a lone \0)
+        attrs, _, pos = _read_header(data, pos)
+        headers.append(attrs)
+        if not multipart or data[pos:pos + 1] == b"\0":
+            pos += 1 if multipart else 0
+            break
+    layouts = [_layout(h) for h in headers]
+    planes = {}
+    for attrs, layout in zip(headers, layouts):
+        n_chunks = layout[-1]
+        offsets = struct.unpack_from(f"<{n_chunks}Q", data, pos)
+        pos += 8 * n_chunks
+        _read_part(data, offsets, layout, attrs["compression"], multipart, planes)
+    attrs = dict(headers[0])
+    attrs["channels"] = [name for name in planes]
     return attrs, planes

@@ -169,3 +169,28 @@ def test_environment_bake_without_openexr_equals_the_openexr_bake(tmp_path, monk
     assert levels.shape == (3, 8, 16, 3) and rl == [0.0, 0.5, 1.0]
     again = prefilter.bake_environment_image(image, "synthetic", "test://synthetic", tmp_path / "pure", settings)
     assert again.states == {"sh": "cached", "prefiltered": "cached"}    # the pure files pass the cache check
+
+
+@pytest.mark.parametrize("compression", [OpenEXR.ZIP_COMPRESSION, OpenEXR.NO_COMPRESSION])
+def test_multi_part_files_read_like_openexr(tmp_path, monkeypatch, compression):
+    """Blender's multilayer renders are multi-part EXRs: the built-in reader gives every part's channels, as
+    the OpenEXR package does, so the validation reads renders in a Python without OpenEXR (Blender's)."""
+    from rt_lookdev.validation import exr_images
+
+    rng = np.random.default_rng(7)
+    parts = []
+    for name, (h, w) in (("ViewLayer.Combined", (21, 13)), ("ViewLayer.Normal", (21, 13))):
+        channels = {f"{name}.{c}": rng.normal(size=(h, w)).astype(np.float32) for c in "RGB"}
+        header = {"compression": compression, "type": OpenEXR.scanlineimage, "name": name}
+        parts.append(OpenEXR.Part(header, channels))
+    path = tmp_path / "multilayer.exr"
+    with OpenEXR.File(parts) as f:
+        f.write(str(path))
+    expected = exr_images.read_channels(path)                          # with the OpenEXR package
+    attrs, planes = exr_reader.read(path)
+    assert sorted(planes) == sorted(expected) and len(planes) == 6
+    for name, plane in planes.items():
+        assert np.array_equal(plane, expected[name]), name
+    monkeypatch.setitem(sys.modules, "OpenEXR", None)                  # as in Blender's Python
+    without = exr_images.read_channels(path)
+    assert all(np.array_equal(without[n], expected[n]) for n in expected)
