@@ -7,7 +7,7 @@ Registration does no file I/O.
 """
 import bpy
 
-from . import compat, convert, export_operators, operators, preferences, ui
+from . import compat, convert, export_operators, light_sync, operators, preferences, ui
 
 classes = (
     *operators.classes,
@@ -29,9 +29,11 @@ def register():
         bpy.utils.register_class(cls)
     for menu, draw in menus:
         menu.append(draw)
+    light_sync.register()
 
 
 def unregister():
+    light_sync.unregister()
     for menu, draw in reversed(menus):
         menu.remove(draw)
     for cls in reversed(classes):

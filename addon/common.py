@@ -21,6 +21,9 @@ FEATURES_KEY = "rtl_features"
 WORLD_RECORD_KEY = "rtl_world"
 #: Custom property of ``SCENE_LIGHTS_GROUP`` listing "<object>:<kind>" per synced light.
 LIGHTS_RECORD_KEY = "rtl_lights"
+#: Custom property of ``SCENE_LIGHTS_GROUP``: the synced lights' "<object>:<kind>:<shape>", what the
+#: automatic light sync compares (addon/light_sync.py).
+LIGHTS_SIGNATURE_KEY = "rtl_light_signature"
 #: Custom property of an emitted group: emitter version and structure hash (rebuilt when it changes).
 STAMP_KEY = "rtl_stamp"
 #: Name of the RT Lit group node inside a converted material.
@@ -29,7 +32,7 @@ RT_LIT_NODE_NAME = "RT Lit"
 IMAGE_PREFIX = "RTL_"
 
 __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WORLD_GROUP", "FEATURES_KEY",
-           "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
+           "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "LIGHTS_SIGNATURE_KEY", "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
            "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver"]
 
 SOCKET_TYPES = {"float": "NodeSocketFloat", "vector": "NodeSocketVector", "color": "NodeSocketColor",

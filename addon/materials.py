@@ -27,7 +27,8 @@ from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, RT_LIT_OUTPUTS,
                                                Features, light_input, rt_lit_group_name)
 from . import compat, node_emit, world_sync
-from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP,
+from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LIGHTS_SIGNATURE_KEY, RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME,
+                     SCENE_LIGHTS_GROUP,
                      WORLD_GROUP, add_driver, ensure_interface, remove_drivers, socket_by_identifier)
 
 _AREA_SHAPES = {"SQUARE": "quad", "RECTANGLE": "quad", "DISK": "disk", "ELLIPSE": "disk"}
@@ -152,7 +153,23 @@ def sync_scene_lights(scene):
         ng.links.new(value.outputs[0], socket_by_identifier(out.inputs, items[(name, "OUTPUT")].identifier))
     out.location = (400.0, 0.0)
     ng[LIGHTS_RECORD_KEY] = [f"{obj.name}:{kind}" for obj, kind in records]
+    ng[LIGHTS_SIGNATURE_KEY] = light_signature(records)
     return records
+
+
+def light_signature(records):
+    """What the RT Lit groups depend on in a light list: each light's name, kind and area shape."""
+    return [f"{obj.name}:{kind}:{_shape(obj) or ''}" for obj, kind in records]
+
+
+def lights_out_of_sync(scene):
+    """Whether ``scene``'s shaded lights differ from the ones the RT Lit groups were last synced for (False
+    when the file has no RT Lit group: nothing to keep in sync)."""
+    if not any(ng.name.startswith(RT_LIT_GROUP_PREFIX) and FEATURES_KEY in ng for ng in bpy.data.node_groups):
+        return False
+    ng = bpy.data.node_groups.get(SCENE_LIGHTS_GROUP)
+    synced = list(ng.get(LIGHTS_SIGNATURE_KEY, [])) if ng is not None else []
+    return light_signature(scene_lights(scene)) != synced
 
 
 def synced_light_kinds():

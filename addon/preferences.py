@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import bpy
-from bpy.props import StringProperty
+from bpy.props import BoolProperty, StringProperty
 
 from ..core.lut import catalog
 
@@ -74,10 +74,17 @@ class RTL_AddonPreferences(bpy.types.AddonPreferences):
         subtype='DIR_PATH',
         default="",
     )
+    auto_sync_lights: BoolProperty(
+        name="Sync Lights Automatically",
+        description=("Rebuild the RT Lit groups when lights are added, removed, hidden from renders, moved to an "
+                     "excluded collection or change shape (moving and editing lights needs no sync)"),
+        default=True,
+    )
 
     def draw(self, context):
         layout = self.layout
         layout.prop(self, "lut_directory")
+        layout.prop(self, "auto_sync_lights")
 
         lut_dir = lut_directory(context)
         box = layout.box()

@@ -94,8 +94,8 @@ def test_register_unregister_fifty_times_leaves_nothing(bpy_module, empty_scene)
 
 
 def test_undo_and_redo_convert_and_sync_lights(registered, empty_scene, lut_dir):
-    """Undo after Convert gives the Principled material back; redo the RT Lit one.  Undo after Sync Lights
-    gives the groups of the previous light set back."""
+    """Undo after Convert gives the Principled material back; redo the RT Lit one.  Undo after adding and
+    syncing a light removes both; redo brings both back."""
     from rt_lookdev.addon import compat, convert
 
     bpy = registered
@@ -116,15 +116,17 @@ def test_undo_and_redo_convert_and_sync_lights(registered, empty_scene, lut_dir)
     bpy.ops.ed.redo()
     assert convert.is_rt_lit_material(bpy.data.materials["Undoable"])
 
-    bpy.ops.ed.undo_push(message="before sync")
+    # lights follow undo: the automatic sync (addon/light_sync.py) keeps the groups on the scene's lights
+    bpy.ops.ed.undo_push(message="before the light")
     _point_light(bpy, bpy.context.scene, "Key", (1.0, 1.0, 2.0))
-    bpy.ops.ed.undo_push(message="light added")
     assert bpy.ops.rtl.sync_lights('EXEC_DEFAULT', True) == {'FINISHED'}
     assert len(_light_terms(bpy)) == 1
     bpy.ops.ed.undo()
-    assert len(_light_terms(bpy)) == 0
+    bpy.context.view_layer.update()
+    assert "Key" not in bpy.data.objects and len(_light_terms(bpy)) == 0
     bpy.ops.ed.redo()
-    assert len(_light_terms(bpy)) == 1
+    bpy.context.view_layer.update()
+    assert "Key" in bpy.data.objects and len(_light_terms(bpy)) == 1
 
 
 @pytest.mark.parametrize("size", [(1, 1), (2, 1), (4, 2)])
@@ -215,3 +217,50 @@ def test_sync_lights_names_what_is_not_shaded_and_the_capacity_of_each_feature_s
     assert "not shaded: Key (exposure +1, radius 0.1 m), Sun (angle 5.7 deg)" in out
     assert "(kulla-conty, wrapped, sheen, cloth) at most 3 lights" in out
     assert "(single, lambert)" not in out.split("capacity")[-1]       # 4 lights are within its 15
+
+
+def test_lights_stay_in_sync_without_a_button(registered, empty_scene, lut_dir):
+    """With the add-on enabled, adding, hiding, excluding, removing a light or changing an area light's shape
+    re-syncs RT Lit at the next depsgraph update; moving a light changes nothing to sync."""
+    bpy = registered
+    scene = empty_scene
+    _rt_lit_object(bpy, scene, lut_dir)
+
+    def update():
+        bpy.context.view_layer.update()
+        return [kind for _, kind in _light_terms(bpy)]
+
+    key = _point_light(bpy, scene, "Key", (1.0, 2.0, 3.0))
+    assert update() == ["point"]
+    area = bpy.data.objects.new("Panel", bpy.data.lights.new("Panel", "AREA"))
+    scene.collection.objects.link(area)
+    assert update() == ["point", "quad"]                    # "Key", "Panel" in name order
+    area.data.shape = "DISK"
+    assert update() == ["point", "disk"]
+    key.hide_render = True
+    assert update() == ["disk"]
+    key.hide_render = False
+    off = bpy.data.collections.new("Off")
+    scene.collection.children.link(off)
+    off.objects.link(area)
+    scene.collection.objects.unlink(area)
+    bpy.context.view_layer.layer_collection.children["Off"].exclude = True
+    assert update() == ["point"]
+    signature = dict(bpy.data.node_groups["RTL Scene Lights"])["rtl_light_signature"]
+    key.location = (5.0, 5.0, 5.0)                           # drivers follow it: no re-sync
+    update()
+    assert dict(bpy.data.node_groups["RTL Scene Lights"])["rtl_light_signature"] == signature
+    bpy.data.objects.remove(key)
+    assert update() == []
+
+
+def test_light_sync_benchmark_writes_its_report(bpy_module, tmp_path, lut_dir):
+    """The README's `python scripts/benchmark_light_sync.py` (small here): report and JSON written."""
+    from rt_lookdev.validation import light_sync_benchmark
+
+    out = tmp_path / "light_sync.md"
+    result = light_sync_benchmark.run(light_sync_benchmark.parse_args(
+        ["--objects", "12", "--lights", "3", "--repeats", "5", "--lut-dir", str(lut_dir), "--out", str(out)]),
+        log=lambda line: None)
+    assert out.read_text().startswith("# Automatic light sync") and out.with_suffix(".json").is_file()
+    assert result["no_change_check_ms"] > 0.0 and result["resync_adding_a_light_ms"] > 0.0

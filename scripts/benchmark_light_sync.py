@@ -1,0 +1,17 @@
+"""The automatic light sync's cost per depsgraph update; writes docs/benchmarks/light_sync.{md,json}.
+
+    python scripts/benchmark_light_sync.py [--objects 100] [--lights 10] [--repeats 200]
+
+Entry point of ``rt_lookdev.validation.light_sync_benchmark``; ``--help`` lists the options."""
+import sys
+
+from rt_lookdev.validation import light_sync_benchmark
+
+
+def main(argv):
+    light_sync_benchmark.run(light_sync_benchmark.parse_args(argv))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
