@@ -7,13 +7,14 @@ Registration does no file I/O.
 """
 import bpy
 
-from . import compat, convert, export_operators, light_sync, operators, preferences, ui
+from . import compat, convert, export_operators, light_sync, operators, preferences, switches, ui
 
 classes = (
     *operators.classes,
     *export_operators.classes,
     *convert.classes,
     *preferences.classes,
+    *switches.classes,
     *ui.classes,
 )
 #: (menu, draw function): entries appended to Blender's menus (File > Export).
@@ -29,11 +30,13 @@ def register():
         bpy.utils.register_class(cls)
     for menu, draw in menus:
         menu.append(draw)
+    switches.register()
     light_sync.register()
 
 
 def unregister():
     light_sync.unregister()
+    switches.unregister()
     for menu, draw in reversed(menus):
         menu.remove(draw)
     for cls in reversed(classes):

@@ -73,6 +73,8 @@ DIFFUSE_LABELS = {
 }
 
 SPECULAR_ITEMS = tuple((m, *SPECULAR_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SPECULAR_MODELS)
+ENVIRONMENT_MS_ITEMS = (('irradiance', "Irradiance", "Fdez-Aguera 2019: FssEss x radiance + FmsEms x irradiance"),
+                        ('radiance', "Radiance", "The talk: (FssEss + FmsEms) x prefiltered radiance"))
 DIFFUSE_ITEMS = tuple((m, *DIFFUSE_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in DIFFUSE_MODELS)
 
 
@@ -659,8 +661,7 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
         name="World Multiscattering",
         description="Fdez-Aguera multiple scattering under the world: lit by the irradiance (the paper) or "
                     "by the prefiltered radiance (the talk's approximation)",
-        items=(('irradiance', "Irradiance", "Fdez-Aguera 2019: FssEss x radiance + FmsEms x irradiance"),
-               ('radiance', "Radiance", "The talk: (FssEss + FmsEms) x prefiltered radiance")),
+        items=ENVIRONMENT_MS_ITEMS,
         default=Features().environment_ms,
     )
 

@@ -26,9 +26,18 @@ class RTL_PT_material(_PropertiesPanel, bpy.types.Panel):
         mat = context.material
         col = layout.column(align=True)
         if convert.is_rt_lit_material(mat):
-            features = mat.get(FEATURES_KEY, {})
-            col.label(text="RT Lit: " + ", ".join(f"{k} {v}" for k, v in dict(features).items()))
-            col.operator("rtl.convert_to_rt_lit", text="Change Switches")
+            switches = getattr(mat, "rtl_switches", None)
+            if switches is not None:          # editing a switch rebuilds the group (addon/switches.py)
+                col.prop(switches, "specular")
+                sub = col.row()
+                sub.active = switches.specular == "fdez_aguera"
+                sub.prop(switches, "environment_ms")
+                col.prop(switches, "diffuse")
+                row = col.row()
+                row.prop(switches, "sheen")
+                row.prop(switches, "cloth")
+            else:
+                col.label(text="RT Lit: " + ", ".join(f"{k} {v}" for k, v in dict(mat.get(FEATURES_KEY, {})).items()))
             col.operator("rtl.convert_to_principled", icon='MATERIAL')
         else:
             col.operator("rtl.convert_to_rt_lit", icon='SHADING_RENDERED')

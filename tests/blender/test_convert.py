@@ -464,3 +464,28 @@ def test_sheen_off_with_a_sheen_material_says_so(bpy_module, convert, factory):
     plain = _new_material(bpy_module, "Plain")
     assert not convert.principled_uses_sheen(plain)
     assert not any("Sheen" in w for w in convert.principled_to_rt_lit(plain, factory, Features()).warnings)
+
+
+def test_switches_in_the_panel_rebuild_the_group(bpy_module, empty_scene, lut_dir):
+    """Material.rtl_switches shows the stored switches and, when one is set, rebuilds the material's RT Lit
+    group with it (values and links kept), as the Convert dialog does."""
+    from rt_lookdev import addon
+    from rt_lookdev.addon import convert
+
+    addon.register()
+    try:
+        mat = _principled_material(bpy_module, "Switchable")
+        convert.principled_to_rt_lit(mat, convert.default_group_factory(lut_dir), Features("turquin", "cod"))
+        switches = mat.rtl_switches
+        assert (switches.specular, switches.diffuse, switches.sheen) == ("turquin", "cod", False)
+        rt = convert.find_rt_lit_node(mat)
+        roughness = rt.inputs["Roughness"].default_value
+        switches.sheen = True
+        switches.specular = "kulla_conty"
+        assert convert.stored_features(mat) == Features("kulla_conty", "cod", sheen=True)
+        rt = convert.find_rt_lit_node(mat)
+        assert "kulla-conty, cod, sheen" in rt.node_tree.name
+        assert rt.inputs["Roughness"].default_value == roughness and rt.inputs["Base Color"].is_linked
+        assert (switches.specular, switches.sheen) == ("kulla_conty", True)
+    finally:
+        addon.unregister()
