@@ -158,9 +158,13 @@ def run(out_dir, lut_dir=None, resolution=256, repeats=3, eevee=True, log=print,
         result["eevee_available"] = why
         if ok:
             times = []
-            for _ in range(2):
-                r = render_engines(scene, engines=("BLENDER_EEVEE",), resolution=size, path=out_dir)
-                times.append(r["BLENDER_EEVEE"][1])
+            world = scene.world           # EEVEE's measurement setup swaps in a black world: put it back after
+            try:
+                for _ in range(2):
+                    r = render_engines(scene, engines=("BLENDER_EEVEE",), resolution=size, path=out_dir)
+                    times.append(r["BLENDER_EEVEE"][1])
+            finally:
+                scene.world = world
             ev = r["BLENDER_EEVEE"][0]
             stats = compare(cycles, ev, positive_floor=POSITIVE_FLOOR)
             c, e = cycles.astype(np.float64), ev.astype(np.float64)
