@@ -5,8 +5,8 @@
 image textures at texel centres (a plane exactly filling an orthographic camera, one pixel per
 texel, a 0.01-pixel Gaussian filter, 1 sample), feeds the group, routes the output through an
 Emission shader (float: Combine Color with R = value; vector: XYZ -> RGB), renders a 32-bit float
-single-layer EXR with Cycles CPU and reads it back with OpenEXR.  Everything it creates is removed
-again, so it can be called repeatedly in the current scene.
+single-layer EXR with Cycles CPU and reads it back with OpenEXR.  It renders a scene of its own, so the
+file's scenes neither change nor show, and everything it creates is removed again.
 """
 from __future__ import annotations
 
@@ -210,12 +210,12 @@ def _render(bpy, scene, w, h, path, engine):
     _setup_render(scene, w, h, path, engine)
     t0 = time.perf_counter()
     if engine == "CYCLES":
-        bpy.ops.render.render(write_still=True)
+        bpy.ops.render.render(write_still=True, scene=scene.name)
     else:
         from .render_setup import eevee_texture_filtering
 
         with eevee_texture_filtering():
-            bpy.ops.render.render(write_still=True)
+            bpy.ops.render.render(write_still=True, scene=scene.name)
     LAST_RENDER_SECONDS[0] = time.perf_counter() - t0
 
 
@@ -226,12 +226,11 @@ def _read_back(path, h0, w0, is_vector):
     return rgb.copy() if is_vector else rgb[..., 0].copy()
 
 
-def _cleanup(bpy, scene, created, old_camera, old_world):
-    """Restore the scene's camera and world and remove every datablock in ``created``."""
-    scene.camera, scene.world = old_camera, old_world
+def _cleanup(bpy, created):
+    """Remove every datablock in ``created`` (the render's own scene last)."""
     for obj in created.get("objects", []):
         bpy.data.objects.remove(obj, do_unlink=True)
-    for key in ("meshes", "cameras", "materials", "images", "worlds"):
+    for key in ("meshes", "cameras", "materials", "images", "worlds", "scenes"):
         coll = getattr(bpy.data, key)
         for item in created.get(key, []):
             coll.remove(item)
@@ -249,9 +248,11 @@ def render_group_outputs(ng, inputs, output_name, engine="CYCLES", finite_mask=F
     import bpy
 
     arrays, (h0, w0), (h, w) = _padded_inputs(inputs)
-    scene = bpy.context.scene
-    created = {"images": [], "materials": [], "meshes": [], "objects": [], "cameras": [], "worlds": []}
-    old_camera, old_world = scene.camera, scene.world
+    # a scene of its own: nothing of the current file's scenes (objects in front of the plane, render
+    # settings of another measurement) reaches the pixels, and nothing of them is changed
+    scene = bpy.data.scenes.new("RTL_conformance")
+    created = {"images": [], "materials": [], "meshes": [], "objects": [], "cameras": [], "worlds": [],
+               "scenes": [scene]}
     tmp = tempfile.TemporaryDirectory(prefix="rtl-conformance-")
     try:
         mat, is_vector = _build_material(bpy, ng, arrays, h, w, output_name, created, finite_mask)
@@ -261,7 +262,7 @@ def render_group_outputs(ng, inputs, output_name, engine="CYCLES", finite_mask=F
         _render(bpy, scene, w, h, path, engine)
         return _read_back(path, h0, w0, is_vector)
     finally:
-        _cleanup(bpy, scene, created, old_camera, old_world)
+        _cleanup(bpy, created)
         tmp.cleanup()
 
 

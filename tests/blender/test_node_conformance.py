@@ -227,3 +227,31 @@ def bpy_images():
     import bpy
 
     return list(bpy.data.images)
+
+
+def test_renders_are_independent_of_the_current_scene(empty_scene):
+    """render_group_outputs renders a scene of its own: a plane in front of everything, another camera and
+    world and a 50% resolution in the current scene change no pixel, and that scene is left as it was (the
+    main job's robustness step ran after the world validation's scene and read its spheres)."""
+    import bpy
+
+    from rt_lookdev.core import shading_ops as op
+    from rt_lookdev.core.ir import trace
+    from rt_lookdev.addon.node_emit import build_node_group
+
+    _, out = trace(lambda a, b: op.sqrt(a * a + b), {"a": "float", "b": "float"})
+    ng = build_node_group("RTL_scene_independent", {"out": out}, input_order=["a", "b"])
+    rng = np.random.default_rng(3)
+    vals = {n: rng.uniform(0.0, 2.0, (8, 8)).astype(np.float32) for n in ("a", "b")}
+    clean = render_group_outputs(ng, vals, "out")
+    scene = empty_scene
+    mesh = bpy.data.meshes.new("blocker")
+    mesh.from_pydata([(-50, -50, 0.5), (50, -50, 0.5), (50, 50, 0.5), (-50, 50, 0.5)], [], [(0, 1, 2, 3)])
+    blocker = bpy.data.objects.new("blocker", mesh)
+    scene.collection.objects.link(blocker)
+    scene.render.resolution_percentage = 50
+    before = (sorted(o.name for o in scene.objects), scene.camera, scene.world, len(bpy.data.scenes))
+    cluttered = render_group_outputs(ng, vals, "out")
+    assert np.array_equal(clean, cluttered)
+    assert (sorted(o.name for o in scene.objects), scene.camera, scene.world, len(bpy.data.scenes)) == before
+    assert scene.render.resolution_percentage == 50
