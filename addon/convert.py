@@ -297,6 +297,19 @@ def ignored_principled_inputs(node):
     return tuple(ignored)
 
 
+def draw_switches(layout, owner):
+    """The RT Lit switches of ``owner`` (the Convert dialog, or a material's ``rtl_switches``): specular,
+    the world form (active for Fdez-Aguera), diffuse, sheen and cloth."""
+    layout.prop(owner, "specular")
+    sub = layout.row()
+    sub.active = owner.specular == 'fdez_aguera'
+    sub.prop(owner, "environment_ms")
+    layout.prop(owner, "diffuse")
+    row = layout.row()
+    row.prop(owner, "sheen")
+    row.prop(owner, "cloth")
+
+
 def principled_uses_sheen(material):
     """Whether ``material``'s Principled BSDF (feeding its active output) has sheen: Sheen Weight > 0 or
     linked.  The Convert dialog turns the sheen switch on for it."""
@@ -688,16 +701,8 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
         return context.window_manager.invoke_props_dialog(self)
 
     def draw(self, context):
-        layout = self.layout
-        layout.prop(self, "target")
-        layout.prop(self, "specular")
-        sub = layout.row()
-        sub.active = self.specular == 'fdez_aguera'
-        sub.prop(self, "environment_ms")
-        layout.prop(self, "diffuse")
-        row = layout.row()
-        row.prop(self, "sheen")
-        row.prop(self, "cloth")
+        self.layout.prop(self, "target")
+        draw_switches(self.layout, self)
 
     def execute(self, context):
         materials = target_materials(context, self.target)

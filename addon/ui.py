@@ -28,14 +28,7 @@ class RTL_PT_material(_PropertiesPanel, bpy.types.Panel):
         if convert.is_rt_lit_material(mat):
             switches = getattr(mat, "rtl_switches", None)
             if switches is not None:          # editing a switch rebuilds the group (addon/switches.py)
-                col.prop(switches, "specular")
-                sub = col.row()
-                sub.active = switches.specular == "fdez_aguera"
-                sub.prop(switches, "environment_ms")
-                col.prop(switches, "diffuse")
-                row = col.row()
-                row.prop(switches, "sheen")
-                row.prop(switches, "cloth")
+                convert.draw_switches(col, switches)
             else:
                 col.label(text="RT Lit: " + ", ".join(f"{k} {v}" for k, v in dict(mat.get(FEATURES_KEY, {})).items()))
             col.operator("rtl.convert_to_principled", icon='MATERIAL')
