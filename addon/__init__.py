@@ -3,22 +3,24 @@
 Everything that touches ``bpy`` lives here; the numeric work is in ``..core``.  Each
 submodule defines its classes, and this module registers them in one ``classes``
 tuple (in order), then appends the ``menus`` entries; unregistering does both in reverse.
-Registration does no file I/O.
+Registration reads no file (it only checks that the preset library exists, to list it as an asset library).
 """
 import bpy
 
-from . import compat, convert, export_operators, light_sync, operators, preferences, switches, ui
+from . import (compat, convert, export_operators, light_sync, lookdev_operators, operators, preferences, presets,
+               switches, ui)
 
 classes = (
     *operators.classes,
     *export_operators.classes,
+    *lookdev_operators.classes,
     *convert.classes,
     *preferences.classes,
     *switches.classes,
     *ui.classes,
 )
-#: (menu, draw function): entries appended to Blender's menus (File > Export).
-menus = (*export_operators.menus,)
+#: (menu, draw function): entries appended to Blender's menus (File > Export, 3D viewport > Add).
+menus = (*export_operators.menus, *lookdev_operators.menus)
 
 
 def register():
@@ -32,9 +34,11 @@ def register():
         menu.append(draw)
     switches.register()
     light_sync.register()
+    presets.register_library()
 
 
 def unregister():
+    presets.unregister_library()
     light_sync.unregister()
     switches.unregister()
     for menu, draw in reversed(menus):

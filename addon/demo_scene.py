@@ -51,75 +51,18 @@ VARIANTS = (
 )
 
 
-def _principled(bpy, name, values):
-    from . import compat
-    mat = compat.new_material(name)
-    nodes = mat.node_tree.nodes
-    bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
-    for key, value in values.items():
-        bsdf.inputs[key].default_value = value
-    return mat
-
-
-def _sphere(bpy, name, location, material):
-    mesh = bpy.data.meshes.new(name)
-    import bmesh
-
-    bm = bmesh.new()
-    bmesh.ops.create_uvsphere(bm, u_segments=64, v_segments=32, radius=RADIUS)
-    bm.to_mesh(mesh)
-    bm.free()
-    for poly in mesh.polygons:
-        poly.use_smooth = True
-    mesh.materials.append(material)
-    obj = bpy.data.objects.new(name, mesh)
-    obj.location = location
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
-
-
-def _light(bpy, name, shape, size, size_y, power, location, rotation, color=(1.0, 1.0, 1.0)):
-    data = bpy.data.lights.new(name, "AREA")
-    data.shape = shape
-    data.size = size
-    data.size_y = size_y
-    data.energy = power
-    data.color = color
-    obj = bpy.data.objects.new(name, data)
-    obj.location = location
-    obj.rotation_euler = rotation
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
-
-
 DEFAULT_HDRI = "forest"
 WORLD_ROTATION_Z = 1.2          # radians, the Mapping node's Z rotation
 
 
 def add_hdri_world(bpy, scene, hdri, strength, rotation_z=WORLD_ROTATION_Z):
-    """World = Background(strength) <- Environment Texture(hdri) <- Mapping(rotation) <- Generated."""
-    from . import compat
-    from ..core.environment import equirect
+    """The lookdev scene's HDRI world (``lookdev_scene.add_hdri_world``), neither importance-sampled nor
+    seen by the camera: the RT Lit materials are emission only, so Cycles needs no importance map of the
+    world (building it cost ~0.8 s per demo render, measured), and the background is black, as EEVEE's
+    measurement world (scripts/demo_report.py compares the two)."""
+    from . import lookdev_scene
 
-    world = compat.new_world(f"HDRI {hdri}")
-    scene.world = world
-    nt = world.node_tree
-    nt.nodes.clear()
-    out = nt.nodes.new("ShaderNodeOutputWorld")
-    background = nt.nodes.new("ShaderNodeBackground")
-    background.inputs["Strength"].default_value = strength
-    env = nt.nodes.new("ShaderNodeTexEnvironment")
-    env.image = bpy.data.images.load(str(equirect.resolve_hdri(hdri)), check_existing=True)
-    mapping = nt.nodes.new("ShaderNodeMapping")
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
-    coords = nt.nodes.new("ShaderNodeTexCoord")
-    nt.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
-    nt.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
-    nt.links.new(env.outputs["Color"], background.inputs["Color"])
-    nt.links.new(background.outputs["Background"], out.inputs["Surface"])
-    # The RT Lit materials are emission only: Cycles needs no importance map of the world (building it
-    # cost ~0.8 s per demo render, measured) and the camera should not see it (a black background,
-    # as EEVEE's measurement world: scripts/demo_report.py compares the two).
+    world = lookdev_scene.add_hdri_world(scene, hdri, strength, rotation_z)
     world.cycles.sampling_method = "NONE"
     world.cycles_visibility.camera = False
     return world
@@ -132,6 +75,7 @@ def build_demo_scene(lut_dir=None, resolution=256, hdri=DEFAULT_HDRI, world_stre
 
     from . import convert, materials
     from . import world_sync as rtl_world
+    from .lookdev_scene import light, ortho_camera, principled_material, sphere
     from ..core.materials.rt_lit_interface import Features
 
     bpy.ops.wm.read_homefile(use_empty=True)
@@ -142,9 +86,11 @@ def build_demo_scene(lut_dir=None, resolution=256, hdri=DEFAULT_HDRI, world_stre
     rtl_world.sync_world(scene)       # no usable image: no "RTL World" group, no World term
 
     # lights first: the RT Lit groups are built for the scene's lights
-    _light(bpy, "Quad Key", "RECTANGLE", 2.0, 1.0, 600.0, (-2.0, -3.0, 2.5), (0.9, 0.0, -0.6),
-           (1.0, 0.95, 0.9))
-    _light(bpy, "Disk Fill", "DISK", 1.5, 1.5, 300.0, (3.0, -2.5, 0.5), (1.45, 0.0, 0.85), (0.8, 0.9, 1.0))
+    root = scene.collection
+    light("Quad Key", "AREA", 600.0, (-2.0, -3.0, 2.5), (0.9, 0.0, -0.6), root, (1.0, 0.95, 0.9),
+          shape="RECTANGLE", size=2.0, size_y=1.0)
+    light("Disk Fill", "AREA", 300.0, (3.0, -2.5, 0.5), (1.45, 0.0, 0.85), root, (0.8, 0.9, 1.0),
+          shape="DISK", size=1.5, size_y=1.5)
     materials.sync_scene_lights(scene)
 
     def factory(features):
@@ -155,29 +101,23 @@ def build_demo_scene(lut_dir=None, resolution=256, hdri=DEFAULT_HDRI, world_stre
     for row, (label, values, feats) in enumerate(ROWS):
         for col, r in enumerate(ROUGHNESS):
             name = f"{label} r{r:.2f}"
-            mat = _principled(bpy, name, dict(values, Roughness=r))
+            mat = principled_material(name, dict(values, Roughness=r))
             features = Features(**feats)
             convert.principled_to_rt_lit(mat, factory, features)
-            _sphere(bpy, name, (x0 + col * SPACING, 0.0, (1 - row) * SPACING), mat)
+            sphere(name, (x0 + col * SPACING, 0.0, (1 - row) * SPACING), mat, root, RADIUS)
             spheres[name] = features
     for col, (label, values, feats, rt_values) in enumerate(VARIANTS):
-        mat = _principled(bpy, label, values)
+        mat = principled_material(label, values)
         features = Features(**feats)
         convert.principled_to_rt_lit(mat, factory, features)
         group = mat.node_tree.nodes["RT Lit"]
         for key, value in rt_values.items():
             group.inputs[key].default_value = value
-        _sphere(bpy, label, (x0 + col * SPACING, 0.0, -SPACING), mat)
+        sphere(label, (x0 + col * SPACING, 0.0, -SPACING), mat, root, RADIUS)
         spheres[label] = features
 
-    cam_data = bpy.data.cameras.new("Demo Camera")
-    cam_data.type = "ORTHO"
-    cam_data.ortho_scale = SPACING * len(ROUGHNESS) + 0.2
-    cam = bpy.data.objects.new("Demo Camera", cam_data)
-    cam.location = (0.0, -10.0, 0.0)
-    cam.rotation_euler = (1.5707963267948966, 0.0, 0.0)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
+    scene.camera = ortho_camera("Demo Camera", (0.0, -10.0, 0.0), (1.5707963267948966, 0.0, 0.0),
+                                SPACING * len(ROUGHNESS) + 0.2, root)
     r = scene.render
     r.resolution_x = resolution
     r.resolution_y = resolution          # square (256^2 by default): the rows sit in the middle

@@ -1,6 +1,7 @@
 """Lights in sync without a button: a depsgraph handler that re-syncs the RT Lit groups when the scene's
 shaded lights change (a light added, removed, hidden from renders, moved to an excluded collection, or an
-area light changing shape).
+area light changing shape), and converts a lookdev preset to RT Lit when it is first used
+(``presets.convert_pending``: a preset dropped from the Asset Browser).
 
 Moving and editing a light needs no sync: drivers carry its transform and data into the groups, with
 Python auto-run off too.  The handler only compares the lights' signature (name, kind, shape:
@@ -13,10 +14,10 @@ from __future__ import annotations
 import bpy
 from bpy.app.handlers import persistent
 
-from . import materials, preferences
+from . import materials, preferences, presets
 
-#: Update kinds (datablock types) that can change which lights a scene shades.
-_RELEVANT = (bpy.types.Object, bpy.types.Collection, bpy.types.Light, bpy.types.Scene)
+#: Update kinds (datablock types) that can change which lights a scene shades, or assign a preset.
+_RELEVANT = (bpy.types.Object, bpy.types.Collection, bpy.types.Light, bpy.types.Scene, bpy.types.Material)
 _busy = [False]
 
 
@@ -26,13 +27,21 @@ def enabled():
 
 
 def sync_if_needed(scene, lut_dir=None):
-    """Re-sync the RT Lit groups when ``scene``'s lights changed since the last sync; returns whether it did."""
-    if _busy[0] or not materials.lights_out_of_sync(scene):
+    """Convert the presets first used since the last update, then re-sync the RT Lit groups when ``scene``'s
+    lights changed since the last sync; returns whether anything was done."""
+    if _busy[0]:
         return False
+    pending = presets.pending_presets()
+    if not pending and not materials.lights_out_of_sync(scene):
+        return False
+    lut_dir = lut_dir if lut_dir is not None else preferences.lut_directory()
     _busy[0] = True
     try:
-        materials.sync_scene_lights(scene)
-        materials.rebuild_rt_lit_groups(scene, lut_dir if lut_dir is not None else preferences.lut_directory())
+        for material in pending:
+            presets.convert_preset(material, scene, lut_dir)
+        if materials.lights_out_of_sync(scene):
+            materials.sync_scene_lights(scene)
+            materials.rebuild_rt_lit_groups(scene, lut_dir)
     finally:
         _busy[0] = False
     return True

@@ -77,7 +77,15 @@ def is_rendered(scene, obj):
     if obj.hide_render or any(c.hide_render for c in obj.users_collection):
         return False
     held = {c.name for c in obj.users_collection}
-    return any(layer.use and held & _included_collections(layer.layer_collection) for layer in scene.view_layers)
+    return any(layer.use and held & _layer_collections(scene, layer) for layer in scene.view_layers)
+
+
+def _layer_collections(scene, layer):
+    """The collections ``layer`` renders; a view layer not synced yet (a scene just made by
+    ``bpy.data.scenes.new`` has no layer collection until its first update) excludes nothing."""
+    if layer.layer_collection is None:
+        return {scene.collection.name, *(c.name for c in scene.collection.children_recursive)}
+    return _included_collections(layer.layer_collection)
 
 
 def _included_collections(layer_collection, out=None):

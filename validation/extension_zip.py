@@ -36,6 +36,8 @@ REQUIRED_ENTRIES = (
     "core/lut/",
     "node_groups/",
     "luts/",
+    "assets/rt_lookdev_presets.blend",
+    "assets/blender_assets.cats.txt",
 )
 #: Top-level names that must never be shipped.
 FORBIDDEN_TOP_LEVEL = ("tests", "scripts", "validation", "docs", "out", "dist", ".ci", ".git", ".venv",

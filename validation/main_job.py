@@ -17,15 +17,20 @@ Steps (each prints what it does):
    quad and a disk light, saved to <out>/demo/lookdev_demo.blend; node counts, Cycles render time,
    one EEVEE render compared with Cycles; the scene exported (<out>/demo/realtime_scene) and drawn by
    the GLSL backend's standalone renderer, compared with Cycles.
-7. Real-time backend, quick benchmark (scripts/benchmark_realtime.py --quick): frame time of the
+7. The lookdev scene of "New Lookdev Scene" against its path-traced twin (validation/lookdev_twin.py):
+   RT Lit in Cycles vs Cycles path tracing of the Principled twin, with and without the spheres'
+   shadows, and EEVEE vs Cycles; <out>/lookdev/ and the pictures of docs/images/lookdev_*.png.
+8. Real-time backend, quick benchmark (scripts/benchmark_realtime.py --quick): frame time of the
    emitted material on this machine's OpenGL, into <out>/benchmarks/realtime.md (the full table,
    1080p, is docs/benchmarks/realtime.md).
-8. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
+9. Validation suite (scripts/validate.py): node render vs numpy vs Cycles ground truth or
    brute-force integrals, per technique, with an HTML report in <out>/validation/.
-9. World validation (scripts/validate_world.py): the RT Lit World term under Blender's studio HDRIs
+10. World validation (scripts/validate_world.py): the RT Lit World term under Blender's studio HDRIs
    (Lambert vs Cycles Diffuse, SH-LTC CoD vs brute force, specular vs Cycles Glossy over a roughness
    sweep, the white furnace, node render vs numpy, bake times), report in <out>/validation_world/.
-10. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
+11. Robustness sweep, quick (scripts/robustness_sweep.py --points 2000): NaN, Inf, negative and
+   over-bound counts per technique family and backend.
+12. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
 """
 from __future__ import annotations
 
@@ -57,7 +62,7 @@ LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main jo
 
 
 def step_luts(lut_dir, log=report.flush_log):
-    log(f"[1/11] LUTs in {lut_dir}")
+    log(f"[1/12] LUTs in {lut_dir}")
 
     def progress(group, done, total):
         if done == total or done % max(1, total // 4) == 0:
@@ -71,7 +76,7 @@ def step_luts(lut_dir, log=report.flush_log):
 
 
 def step_numpy_checks(lut_dir, log=report.flush_log):
-    log("[2/11] numpy energy checks")
+    log("[2/12] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -102,7 +107,7 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
 
 
 def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
-    log("[6/11] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
+    log("[6/12] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
     from . import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
@@ -110,8 +115,20 @@ def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
     return result
 
 
+def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
+    log("[7/12] lookdev scene (New Lookdev Scene) vs its path-traced twin, Cycles and EEVEE")
+    from . import lookdev_twin
+
+    result = lookdev_twin.run(out_dir / "lookdev", lut_dir=lut_dir, eevee=eevee, pictures_dir=REPO / "docs" / "images",
+                              log=log)
+    result.pop("images")
+    result["summary_markdown"] = result["summary_markdown"] + "\n" + " ".join(
+        f"![{name}](lookdev/{name})" for name in result["pictures"]) + "\n"
+    return result
+
+
 def step_lut_export(out_dir, lut_dir, log=report.flush_log):
-    log("[4/11] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
+    log("[4/12] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
     from ..core.export import luts as lut_export
 
     t0 = time.perf_counter()
@@ -141,7 +158,7 @@ def step_lut_export(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_robustness(out_dir, lut_dir, log=report.flush_log):
-    log("[10/11] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
+    log("[11/12] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
         "(scripts/robustness_sweep.py --points 2000)")
     from . import robustness
 
@@ -163,7 +180,7 @@ def step_robustness(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_realtime_benchmark(out_dir, log=report.flush_log):
-    log("[7/11] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
+    log("[8/12] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
     from . import glsl_runner, realtime_benchmark
 
     glsl_runner.disable_shader_cache()
@@ -190,7 +207,7 @@ def _run_suite(module, folder, lut_dir, log):
 
 
 def step_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[8/11] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
+    log("[9/12] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
     from . import suite
 
     result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
@@ -199,7 +216,7 @@ def step_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_world_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[9/11] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
+    log("[10/12] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
     from . import world_suite
 
     result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
@@ -209,7 +226,7 @@ def step_world_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
-    log("[5/11] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
+    log("[5/12] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
     from . import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -220,7 +237,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
 
 
 def step_ltc(lut_dir, log=report.flush_log):
-    log("[3/11] LTC area lights: random quads and disks vs brute force")
+    log("[3/12] LTC area lights: random quads and disks vs brute force")
     from . import ltc_benchmark as benchmark_ltc
 
     t0 = time.perf_counter()
@@ -285,6 +302,9 @@ def write_report(job, out_dir):
     demo = job.get("demo")
     lines += ["## Demo lookdev scene (RT Lit materials)", ""]
     lines += [demo["summary_markdown"], ""] if demo else ["Skipped (--skip-render).", ""]
+    twin = job.get("lookdev_twin")
+    lines += ["## The lookdev scene against its path-traced twin", ""]
+    lines += [twin["summary_markdown"], ""] if twin else ["Skipped (--skip-render).", ""]
     bench = job.get("realtime_benchmark")
     lines += ["## Real-time backend: frame time (quick)", ""]
     lines += [bench["summary_markdown"], ""] if bench else ["Skipped.", ""]
@@ -317,7 +337,7 @@ def _passed(job):
     """Every step passed (a skipped render step, None, counts as passed)."""
     return bool(job["luts"]["passed"] and job["numpy_checks"]["passed"] and job["ltc"]["passed"]
                 and all(job.get(k) is None or job[k].get("passed", False)
-                        for k in ("lut_export", "render", "demo", "realtime_benchmark", "validation",
+                        for k in ("lut_export", "render", "demo", "lookdev_twin", "realtime_benchmark", "validation",
                                   "world_validation", "robustness")))
 
 
@@ -334,10 +354,11 @@ def run(args, log=report.flush_log):
     job["numpy_checks"] = step_numpy_checks(args.lut_dir, log)
     job["ltc"] = step_ltc(args.lut_dir, log)
     job["lut_export"] = step_lut_export(args.out, args.lut_dir, log)
-    job["render"] = job["demo"] = job["validation"] = job["world_validation"] = None
+    job["render"] = job["demo"] = job["lookdev_twin"] = job["validation"] = job["world_validation"] = None
     if not args.skip_render:
         job["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
         job["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+        job["lookdev_twin"] = step_lookdev_twin(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
     job["realtime_benchmark"] = step_realtime_benchmark(args.out, log)
     if not args.skip_render:
         job["validation"] = step_validation(args.out, args.lut_dir, log)
@@ -345,7 +366,7 @@ def run(args, log=report.flush_log):
     job["robustness"] = step_robustness(args.out, args.lut_dir, log)
     job["passed"] = _passed(job)
     job["seconds"] = time.perf_counter() - t0
-    log("[11/11] report")
+    log("[12/12] report")
     write_report(job, args.out)
     log((args.out / "report.md").read_text())
     log(f"report written to {args.out / 'report.md'} and report.json")

@@ -36,6 +36,7 @@ def snapshot():
         "scene_props": sorted(bpy.types.Scene.bl_rna.properties.keys()),
         "window_manager_props": sorted(bpy.types.WindowManager.bl_rna.properties.keys()),
         "addons": sorted(bpy.context.preferences.addons.keys()),
+        "asset_libraries": sorted([lib.name, lib.path] for lib in bpy.context.preferences.filepaths.asset_libraries),
     }
 '''
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import re
 import zipfile
-from pathlib import PurePosixPath
+from pathlib import Path, PurePosixPath
 
 import pytest
 
@@ -11,8 +11,8 @@ from rt_lookdev.validation import extension_zip as build_extension
 from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
-OPERATORS = ["add_node_groups", "convert_to_principled", "convert_to_rt_lit", "export_luts", "export_scene", "lut_status",
-             "sync_lights", "sync_world"]
+OPERATORS = ["add_node_groups", "add_path_traced_twin", "convert_to_principled", "convert_to_rt_lit", "export_luts",
+             "export_scene", "lut_status", "new_lookdev_scene", "sync_lights", "sync_world"]
 
 pytestmark = pytest.mark.blender
 
@@ -42,6 +42,8 @@ result["default_lut_dir"] = str(catalog.default_lut_dir())
 result["lut_states"] = {s.name: s.state for s in catalog.lut_status(catalog.default_lut_dir())}
 
 result["enabled_state"] = snapshot()
+with bpy.data.libraries.load(str(installed / "assets" / "rt_lookdev_presets.blend"), assets_only=True) as (src, _):
+    result["preset_assets"] = sorted(src.materials)
 prefs = bpy.context.preferences.addons[MODULE].preferences
 result["prefs_class"] = type(prefs).__name__
 result["prefs_bl_idname"] = type(prefs).bl_idname
@@ -116,7 +118,8 @@ def test_zip_holds_runtime_files_only(extension_zip):
 
 def test_zip_check_rejects_development_files():
     good = ["__init__.py", "blender_manifest.toml", "addon/__init__.py", "core/__init__.py",
-            "core/lut/catalog.py", "node_groups/__init__.py", "luts/e.exr"]
+            "core/lut/catalog.py", "node_groups/__init__.py", "luts/e.exr", "assets/rt_lookdev_presets.blend",
+            "assets/blender_assets.cats.txt"]
     build_extension.check_zip_contents(good, ["luts/e.exr"])
     for extra in ("tests/conftest.py", "scripts/env.sh", "validation/suite.py", ".ci/run", "core/__pycache__/x.pyc"):
         with pytest.raises(build_extension.BuildError, match="should not be shipped"):
@@ -146,8 +149,12 @@ def test_install_enable_run_disable_leaves_nothing_behind(extension_zip, tmp_pat
     assert result["default_lut_dir"].startswith(result["installed_dir"])
     assert result["lut_states"] and set(result["lut_states"].values()) == {"ok"}, result["lut_states"]
 
-    # Enabled: the operators and preferences are registered under the extension's name.
+    # Enabled: the operators and preferences are registered under the extension's name, and the presets are
+    # an asset library of the installed copy
     assert result["enabled_state"]["ops_rtl"] == OPERATORS
+    libraries = [path for name, path in result["enabled_state"]["asset_libraries"] if name == "RT Lookdev"]
+    assert libraries and libraries[0].rstrip("/") == str(Path(result["installed_dir"]) / "assets")
+    assert "RTL Gold" in result["preset_assets"] and len(result["preset_assets"]) >= 10
     assert result["prefs_bl_idname"] == MODULE
     assert result["prefs_class"] == "RTL_AddonPreferences"
     assert result["prefs_lut_directory"] == ""

@@ -1,0 +1,305 @@
+"""The lookdev scene an artist gets in one click, and its path-traced twin.
+
+``new_lookdev_scene(...)`` builds a new scene in the current file (nothing else in the file is touched):
+two rows of spheres across roughness, a dielectric row and a gold row (Principled materials converted to
+RT Lit), a key rectangle light, a fill disk light, a rim spot light, a studio HDRI world (one of
+Blender's own, baked for the World term), an orthographic camera, and render settings for lookdev:
+Cycles with 0 bounces (RT Lit surfaces are emitters: with bounces they would light each other a second
+time), the view transform the artist picks (AgX or Standard).
+
+``add_path_traced_twin(scene)`` adds the scene's twin: a scene "<name> Path Traced" that links the same
+lights, camera and world, and holds a copy of each sphere (same mesh, transform copied from the original
+by a constraint, so moving a sphere moves its twin) whose object-level material is the Principled BSDF
+the RT Lit material was converted from, with the values edited in RT Lit (``convert.rt_lit_to_principled``
+on a copy).  It renders with Cycles path tracing, by default direct light only (0 bounces: what RT Lit
+computes, plus the shadows it does not), so switching scenes compares real-time and path-traced shading.
+``validation.lookdev_twin`` measures the two against each other.
+
+The lights RT Lit shades are one set per file ("RTL Scene Lights", ``materials.py``): the twin shares the
+lookdev scene's lights, so switching to it keeps the RT Lit groups in sync.
+"""
+from __future__ import annotations
+
+import math
+
+import bpy
+
+from . import compat
+
+#: Sphere roughness along each row.
+ROUGHNESS = (0.05, 0.25, 0.5, 0.75, 1.0)
+SPACING = 1.1
+RADIUS = 0.42
+#: (row name, Principled inputs); row 0 on top.  Gold's Base Color is its measured F0, as in the preset
+#: "RTL Gold" (core/materials/presets.py gives the source).
+ROWS = (
+    ("Dielectric", {"Base Color": (0.8, 0.25, 0.1, 1.0), "Metallic": 0.0}),
+    ("Gold", {"Base Color": (1.000, 0.766, 0.336, 1.0), "Metallic": 1.0}),
+)
+DEFAULT_HDRI = "studio"
+VIEW_TRANSFORMS = ("AgX", "Standard")
+TWIN_SUFFIX = " Path Traced"
+#: Custom property on a twin scene: the name of the lookdev scene it copies.
+TWIN_OF_KEY = "rtl_twin_of"
+#: Custom property on a twin sphere: the name of the lookdev object it copies.
+TWIN_SOURCE_KEY = "rtl_twin_source"
+
+
+# --- building blocks (shared with the demo scene) ------------------------------------------------------
+
+def principled_material(name, values):
+    """A new node material whose Principled BSDF has ``values`` (input name -> value)."""
+    mat = compat.new_material(name)
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    for key, value in values.items():
+        bsdf.inputs[key].default_value = value
+    return mat
+
+
+def sphere(name, location, material, collection, radius=RADIUS):
+    """A smooth UV sphere object with ``material``, linked into ``collection``."""
+    import bmesh
+
+    mesh = bpy.data.meshes.new(name)
+    bm = bmesh.new()
+    bmesh.ops.create_uvsphere(bm, u_segments=64, v_segments=32, radius=radius)
+    bm.to_mesh(mesh)
+    bm.free()
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    obj.location = location
+    collection.objects.link(obj)
+    return obj
+
+
+def light(name, kind, power, location, rotation, collection, color=(1.0, 1.0, 1.0), **settings):
+    """A light object of Blender type ``kind`` ("AREA", "SPOT", ...) with ``settings`` on its data."""
+    data = bpy.data.lights.new(name, kind)
+    data.energy = power
+    data.color = color
+    for key, value in settings.items():
+        setattr(data, key, value)
+    obj = bpy.data.objects.new(name, data)
+    obj.location = location
+    obj.rotation_euler = rotation
+    collection.objects.link(obj)
+    return obj
+
+
+def studio_hdris():
+    """{name: path} of the studio HDRIs of the running Blender (``datafiles/studiolights/world``: city,
+    courtyard, forest, interior, night, studio, sunrise, sunset)."""
+    from pathlib import Path
+
+    folder = bpy.utils.system_resource("DATAFILES", path="studiolights/world")
+    return {p.stem: p for p in sorted(Path(folder).glob("*.exr"))} if folder else {}
+
+
+def hdri_path(hdri):
+    """A studio HDRI name of the running Blender, or the path of an equirectangular EXR."""
+    from ..core.environment import equirect
+
+    found = studio_hdris().get(str(hdri))
+    return found if found is not None else equirect.resolve_hdri(hdri)
+
+
+def add_hdri_world(scene, hdri, strength, rotation_z=0.0, name=None):
+    """World = Background(strength) <- Environment Texture(hdri) <- Mapping(rotation) <- Generated, the
+    setup "Sync RT Lit World" bakes (``world_sync.world_setup``)."""
+    world = compat.new_world(name or f"HDRI {hdri}")
+    scene.world = world
+    nt = world.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputWorld")
+    background = nt.nodes.new("ShaderNodeBackground")
+    background.inputs["Strength"].default_value = strength
+    env = nt.nodes.new("ShaderNodeTexEnvironment")
+    env.image = bpy.data.images.load(str(hdri_path(hdri)), check_existing=True)
+    mapping = nt.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    nt.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    nt.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+    nt.links.new(env.outputs["Color"], background.inputs["Color"])
+    nt.links.new(background.outputs["Background"], out.inputs["Surface"])
+    return world
+
+
+def ortho_camera(name, location, rotation, ortho_scale, collection):
+    data = bpy.data.cameras.new(name)
+    data.type = "ORTHO"
+    data.ortho_scale = ortho_scale
+    cam = bpy.data.objects.new(name, data)
+    cam.location = location
+    cam.rotation_euler = rotation
+    collection.objects.link(cam)
+    return cam
+
+
+# --- the lookdev scene ---------------------------------------------------------------------------------
+
+def _studio_lights(collection):
+    """Key rectangle (front left, above), fill disk (front right, low), rim spot (behind, above).  The
+    point-like settings RT Lit does not shade are 0 (spot radius), so nothing is ignored."""
+    key = light("Key Quad", "AREA", 400.0, (-2.5, -3.5, 3.0), (0.85, 0.0, -0.62), collection,
+                (1.0, 0.96, 0.9), shape="RECTANGLE", size=2.0, size_y=1.2)
+    fill = light("Fill Disk", "AREA", 150.0, (3.5, -3.0, 0.8), (1.4, 0.0, 0.86), collection,
+                 (0.85, 0.92, 1.0), shape="DISK", size=1.5)
+    rim = light("Rim Spot", "SPOT", 1500.0, (0.0, 4.0, 3.5), (-0.85, 0.0, 0.0), collection,
+                spot_size=math.radians(60.0), spot_blend=0.2, shadow_soft_size=0.0)
+    return key, fill, rim
+
+
+def configure_lookdev_render(scene, view_transform="AgX", samples=16):
+    """Cycles with no bounces (the RT Lit surfaces are emitters, so a bounce would light the scene a
+    second time), ``samples`` for anti-aliasing, the artist's view transform."""
+    if view_transform not in VIEW_TRANSFORMS:
+        raise ValueError(f"view transform must be one of {VIEW_TRANSFORMS}, got {view_transform!r}")
+    scene.render.engine = "CYCLES"
+    c = scene.cycles
+    c.samples = int(samples)
+    c.preview_samples = max(1, int(samples) // 2)
+    c.max_bounces = 0
+    c.use_denoising = False
+    c.use_preview_denoising = False
+    scene.view_settings.view_transform = view_transform
+    scene.view_settings.look = "None"
+
+
+def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world_strength=1.0,
+                      view_transform="AgX", lut_dir=None, resolution=(960, 480), progress=None):
+    """Build the lookdev scene (see the module doc) as a new scene of the current file; returns it.
+
+    ``features``: the RT Lit switches (``Features``; default ``Features()``); ``hdri``: a studio HDRI name
+    (``core.environment.equirect.studio_hdris``) or an EXR path, None for no world; ``progress(done,
+    total)`` is called after each step (the world bake, each material)."""
+    from ..core.materials.rt_lit_interface import Features
+    from . import convert, materials
+    from . import world_sync as rtl_world
+
+    features = features or Features()
+    total = 2 + len(ROWS) * len(ROUGHNESS)
+    step = [0]
+
+    def advance():
+        step[0] += 1
+        if progress is not None:
+            progress(step[0], total)
+
+    scene = bpy.data.scenes.new(name)
+    configure_lookdev_render(scene, view_transform)
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
+    collection = scene.collection
+    scene.world = None
+    if hdri is not None:
+        world = add_hdri_world(scene, hdri, world_strength, name=f"{name} {hdri}")
+        world.cycles.sampling_method = "AUTOMATIC"   # the twin path-traces this world
+    rtl_world.sync_world(scene)          # bakes (cached) the HDRI; no usable image: no World term
+    advance()
+
+    _studio_lights(collection)
+    materials.sync_scene_lights(scene)   # lights first: the RT Lit groups are built for them
+    advance()
+
+    def factory(feats):
+        return materials.ensure_rt_lit_group(feats, scene, lut_dir)
+
+    x0 = -0.5 * (len(ROUGHNESS) - 1) * SPACING
+    for row, (label, values) in enumerate(ROWS):
+        for col, r in enumerate(ROUGHNESS):
+            object_name = f"{label} r{r:.2f}"
+            mat = principled_material(f"{name} {object_name}", dict(values, Roughness=r))
+            convert.principled_to_rt_lit(mat, factory, features)
+            z = 0.5 * SPACING * (len(ROWS) - 1) - row * SPACING
+            sphere(f"{name} {object_name}", (x0 + col * SPACING, 0.0, z), mat, collection)
+            advance()
+
+    cam = ortho_camera(f"{name} Camera", (0.0, -10.0, 0.0), (0.5 * math.pi, 0.0, 0.0),
+                       SPACING * len(ROUGHNESS) + 0.1, collection)
+    scene.camera = cam
+    return scene
+
+
+def lookdev_spheres(scene):
+    """The mesh objects of ``scene`` whose material is RT Lit, in name order."""
+    from .convert import is_rt_lit_material
+
+    return sorted((o for o in scene.objects if o.type == "MESH" and o.active_material is not None
+                   and is_rt_lit_material(o.active_material)), key=lambda o: o.name)
+
+
+# --- the path-traced twin ------------------------------------------------------------------------------
+
+def twin_material(material):
+    """A Principled copy of the RT Lit ``material``: the values edited in RT Lit carried back
+    (``convert.rt_lit_to_principled`` on a copy; the original stays RT Lit)."""
+    from . import convert
+
+    twin = material.copy()
+    twin.name = material.name + TWIN_SUFFIX
+    convert.rt_lit_to_principled(twin)
+    for key in list(twin.keys()):        # the copy is not an RT Lit material
+        if key.startswith("rtl_"):
+            del twin[key]
+    return twin
+
+
+def add_path_traced_twin(scene, bounces=0, samples=128):
+    """Add (or rebuild) the path-traced twin of the lookdev ``scene``; returns the twin scene.
+
+    Lights, camera and world are the same objects; each RT Lit sphere gets a copy sharing its mesh, with the
+    Principled twin of its material linked to the object and its transform copied from the original."""
+    spheres = lookdev_spheres(scene)
+    if not spheres:
+        raise ValueError(f"scene '{scene.name}' has no RT Lit object to twin")
+    twin_name = scene.name + TWIN_SUFFIX
+    old = bpy.data.scenes.get(twin_name)
+    if old is not None:
+        remove_twin(old)
+    twin = bpy.data.scenes.new(twin_name)
+    twin[TWIN_OF_KEY] = scene.name
+    twin.world = scene.world
+    if scene.world is not None:
+        scene.world.cycles.sampling_method = "AUTOMATIC"
+    twin.camera = scene.camera
+    for attr in ("resolution_x", "resolution_y", "resolution_percentage"):
+        setattr(twin.render, attr, getattr(scene.render, attr))
+    twin.render.engine = "CYCLES"
+    twin.cycles.samples = int(samples)
+    twin.cycles.preview_samples = max(1, int(samples) // 4)
+    twin.cycles.max_bounces = int(bounces)
+    twin.view_settings.view_transform = scene.view_settings.view_transform
+    twin.view_settings.look = scene.view_settings.look
+    for obj in scene.objects:
+        if obj.type in ("LIGHT", "CAMERA"):
+            twin.collection.objects.link(obj)
+    for obj in spheres:
+        copy = obj.copy()                 # shares the mesh (and its RT Lit material slot)
+        copy.name = obj.name + TWIN_SUFFIX
+        copy[TWIN_SOURCE_KEY] = obj.name
+        copy.material_slots[0].link = "OBJECT"
+        copy.material_slots[0].material = twin_material(obj.active_material)
+        constraint = copy.constraints.new("COPY_TRANSFORMS")
+        constraint.target = obj
+        twin.collection.objects.link(copy)
+    return twin
+
+
+def remove_twin(twin):
+    """Remove a twin scene with the objects and materials it made (lights, camera, world, meshes stay)."""
+    for obj in list(twin.objects):
+        if TWIN_SOURCE_KEY in obj.keys():
+            for slot in obj.material_slots:
+                if slot.link == "OBJECT" and slot.material is not None and slot.material.users <= 1:
+                    bpy.data.materials.remove(slot.material)
+            bpy.data.objects.remove(obj)
+    bpy.data.scenes.remove(twin)
+
+
+def twin_of(scene):
+    """The lookdev scene ``scene`` is the twin of, or None."""
+    name = scene.get(TWIN_OF_KEY)
+    return bpy.data.scenes.get(name) if name else None
