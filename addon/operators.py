@@ -4,6 +4,7 @@ from __future__ import annotations
 import bpy
 
 from . import preferences
+from .background_task import ModalTask
 from .common import WORLD_GROUP
 
 #: States that make the tables unusable: the operator fails on these.
@@ -211,14 +212,16 @@ class RTL_OT_add_node_groups(bpy.types.Operator):
         return {'FINISHED'}
 
 
-class RTL_OT_sync_world(bpy.types.Operator):
+class RTL_OT_sync_world(ModalTask, bpy.types.Operator):
     """Bake the World's environment image (cached by its content) and rebuild the RT Lit groups with
     its light; without a usable image (Background <- Environment Texture [<- Mapping]) the World
-    term is off.  Changing the World's strength or Mapping rotation needs no sync: drivers follow it"""
+    term is off.  Changing the World's strength or Mapping rotation needs no sync: drivers follow it.
+    The bake runs in the background (Esc cancels)"""
 
     bl_idname = "rtl.sync_world"
     bl_label = "Sync RT Lit World"
     bl_options = {'REGISTER', 'UNDO'}
+    _label = "RT Lit World bake"
 
     @classmethod
     def poll(cls, context):
@@ -230,35 +233,85 @@ class RTL_OT_sync_world(bpy.types.Operator):
 
         scene = context.scene
         lut_dir = preferences.lut_directory(context)
-        wm = context.window_manager
-        show = wm is not None and not bpy.app.background
-
-        def progress(stage, done, total):
-            # SH: the first 5%; the prefiltered levels: the rest
-            fraction = 0.05 * done / total if stage == "sh" else 0.05 + 0.95 * done / max(total, 1)
-            if show:
-                wm.progress_update(100.0 * fraction)
-
         setup = world.world_setup(scene.world)
-        if show:
-            wm.progress_begin(0, 100)
         try:
-            bake = world.bake_world(scene, progress=progress) if setup.usable else None
-            record = world.sync_world(scene, bake=bake)
-            groups = materials.rebuild_rt_lit_groups(scene, lut_dir)
-            world.remove_stale_environment_images(keep=record and record["table"])
+            job = world.bake_job(scene) if setup.usable else None
         except Exception as ex:
-            self.report({'ERROR'}, f"Could not sync the world: {ex}")
+            self.report({'ERROR'}, f"Could not read the world's image: {ex}")
             return {'CANCELLED'}
-        finally:
-            if show:
-                wm.progress_end()
-        rebuilt = f"{len(groups)} RT Lit groups rebuilt"
-        if record is None:
-            self.report({'WARNING'}, f"RT Lit World term off: {setup.reason}; {rebuilt}")
-        else:
-            self.report({'INFO'}, f"RT Lit World: '{record['image']}' {world.bake_summary(bake)}; {rebuilt}")
-        return {'FINISHED'}
+
+        def work(progress):
+            def stage(name, done, total):     # SH: the first 5%; the prefiltered levels: the rest
+                fraction = 0.05 * done / total if name == "sh" else 0.05 + 0.95 * done / max(total, 1)
+                progress(fraction, f"{name} {done}/{total}")
+            return job(stage) if job is not None else None
+
+        def finish(bake):
+            try:
+                record = world.sync_world(scene, bake=bake)
+                groups = materials.rebuild_rt_lit_groups(scene, lut_dir)
+                world.remove_stale_environment_images(keep=record and record["table"])
+            except Exception as ex:
+                self.report({'ERROR'}, f"Could not sync the world: {ex}")
+                return {'CANCELLED'}
+            rebuilt = f"{len(groups)} RT Lit groups rebuilt"
+            if record is None:
+                self.report({'WARNING'}, f"RT Lit World term off: {setup.reason}; {rebuilt}")
+            else:
+                self.report({'INFO'}, f"RT Lit World: '{record['image']}' {world.bake_summary(bake)}; {rebuilt}")
+            return {'FINISHED'}
+
+        return self.start_task(context, work, finish)
 
 
-classes = (RTL_OT_lut_status, RTL_OT_sync_lights, RTL_OT_sync_world, RTL_OT_add_node_groups)
+class RTL_OT_bake_luts(ModalTask, bpy.types.Operator):
+    """Bake the lookup tables that are missing, stale or corrupt into the LUT directory (each table group is
+    written whole or not at all); in the background, Esc cancels"""
+
+    bl_idname = "rtl.bake_luts"
+    bl_label = "Bake LUTs"
+    bl_options = {'REGISTER'}
+    _label = "RT Lookdev LUT bake"
+
+    force: bpy.props.BoolProperty(name="Force", description="Re-bake the tables that are current too",
+                                  default=False)
+
+    @classmethod
+    def poll(cls, context):
+        lut_dir = preferences.lut_directory(context)
+        if not lut_dir.parent.is_dir():
+            cls.poll_message_set(f"The LUT directory's folder does not exist: {lut_dir.parent}")
+            return False
+        return True
+
+    def execute(self, context):
+        from ..core import lut_bake
+        from ..core.lut import catalog
+
+        lut_dir = preferences.lut_directory(context)
+        todo = [g for g in catalog.GROUPS if self.force or not lut_bake.group_is_current(g, lut_dir)]
+        if not todo:
+            self.report({'INFO'}, f"All {len(catalog.TABLES)} LUT tables in {lut_dir} are current; nothing to bake")
+            return {'FINISHED'}
+        force = self.force
+
+        def work(progress):
+            def step(group, done, total):
+                index = todo.index(group) if group in todo else 0
+                progress((index + done / max(total, 1)) / len(todo), f"{group} {done}/{total}")
+            lut_dir.mkdir(parents=True, exist_ok=True)
+            return lut_bake.bake(lut_dir, force=force, progress=step, groups=todo, workers=1,
+                                 log=lambda line: print(f"RT Lookdev: {line}"))
+
+        def finish(records):
+            preferences.refresh_status(lut_dir)
+            baked = [r for r in records if r.state == "baked"]
+            seconds = sum(r.seconds for r in baked)
+            self.report({'INFO'}, f"Baked {', '.join(r.group for r in baked)} into {lut_dir} in {seconds:.0f} s; "
+                                  "Sync Lights rebuilds the RT Lit groups with them")
+            return {'FINISHED'}
+
+        return self.start_task(context, work, finish)
+
+
+classes = (RTL_OT_lut_status, RTL_OT_bake_luts, RTL_OT_sync_lights, RTL_OT_sync_world, RTL_OT_add_node_groups)

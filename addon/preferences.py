@@ -44,6 +44,14 @@ def lut_directory(context=None) -> Path:
     return catalog.default_lut_dir()
 
 
+def environment_cache_directory(context=None):
+    """The preference "Environment Cache" as a path, or None when it is empty (or the add-on is registered
+    without addon_utils): then ``world_sync.default_cache_dir`` falls back to $RTL_ENVIRONMENT_CACHE."""
+    prefs = get_preferences(context)
+    custom = prefs.environment_cache.strip() if prefs is not None else ""
+    return Path(bpy.path.abspath(custom)).expanduser() if custom else None
+
+
 def refresh_status(lut_dir: Path) -> list:
     """Check every table in ``lut_dir`` and remember the result for draw()."""
     statuses = list(catalog.lut_status(lut_dir))
@@ -74,6 +82,13 @@ class RTL_AddonPreferences(bpy.types.AddonPreferences):
         subtype='DIR_PATH',
         default="",
     )
+    environment_cache: StringProperty(
+        name="Environment Cache",
+        description=("Folder for the baked world environments (SH and prefiltered levels, named by the image's "
+                     "content). Empty: $RTL_ENVIRONMENT_CACHE, else ~/.cache/rt_lookdev/environments"),
+        subtype='DIR_PATH',
+        default="",
+    )
     auto_sync_lights: BoolProperty(
         name="Sync Lights Automatically",
         description=("Rebuild the RT Lit groups when lights are added, removed, hidden from renders, moved to an "
@@ -84,6 +99,7 @@ class RTL_AddonPreferences(bpy.types.AddonPreferences):
     def draw(self, context):
         layout = self.layout
         layout.prop(self, "lut_directory")
+        layout.prop(self, "environment_cache")
         layout.prop(self, "auto_sync_lights")
 
         lut_dir = lut_directory(context)
@@ -104,7 +120,9 @@ class RTL_AddonPreferences(bpy.types.AddonPreferences):
                     row.label(text=status.state)
                     if status.state != "ok" and status.message:
                         col.label(text=f"    {status.message}")
-        layout.operator("rtl.lut_status", icon='FILE_REFRESH')
+        row = layout.row()
+        row.operator("rtl.lut_status", icon='FILE_REFRESH')
+        row.operator("rtl.bake_luts", icon='RENDER_STILL')
 
 
 classes = (RTL_AddonPreferences,)

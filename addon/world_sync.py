@@ -251,10 +251,15 @@ def world_image_array(image):
 
 
 def default_cache_dir():
-    """The bake cache: ``$RTL_ENVIRONMENT_CACHE``, else ``$XDG_CACHE_HOME/rt_lookdev/environments``
-    (``~/.cache`` when XDG_CACHE_HOME is unset); created here."""
+    """The bake cache: the preference "Environment Cache" when set, else ``$RTL_ENVIRONMENT_CACHE``, else
+    ``$XDG_CACHE_HOME/rt_lookdev/environments`` (``~/.cache`` when XDG_CACHE_HOME is unset); created here."""
+    from . import preferences
+
+    chosen = preferences.environment_cache_directory()
     env = os.environ.get(CACHE_ENV)
-    if env:
+    if chosen is not None:
+        path = chosen
+    elif env:
         path = Path(env).expanduser()
     else:
         base = os.environ.get("XDG_CACHE_HOME")
@@ -278,20 +283,32 @@ def _image_source(image):
     return bpy.path.abspath(image.filepath, library=image.library)
 
 
-def bake_world(scene, cache_dir=None, progress=None, force=False, settings=None):
-    """Bake (or find cached) the environment of ``scene``'s World: an ``EnvironmentBake``, or None when
-    the world has no usable image (``world_setup`` says why).  Files ``<image>_<hash12>_*`` in
-    ``cache_dir`` (default ``default_cache_dir()``); ``progress(stage, done, total)`` as in core;
-    ``settings``: ``PrefilterSettings`` (default: the measured defaults)."""
+def bake_job(scene, cache_dir=None, force=False, settings=None):
+    """The bake of ``scene``'s World as a function of ``progress(stage, done, total)`` alone, touching no
+    ``bpy`` (the image is read here, on the calling thread), so it can run in a background thread
+    (``background_task``); None when the world has no usable image (``world_setup`` says why)."""
     setup = world_setup(scene.world)
     if not setup.usable:
         return None
     image = setup.image
     array = world_image_array(image)
     name = f"{_file_stem(image)}_{equirect.image_hash(array)[:12]}"
+    source = _image_source(image)
     out_dir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    return prefilter.bake_environment_image(array, name, _image_source(image), out_dir,
-                                            settings or prefilter.PrefilterSettings(), progress, force)
+    settings = settings or prefilter.PrefilterSettings()
+
+    def bake(progress=None):
+        return prefilter.bake_environment_image(array, name, source, out_dir, settings, progress, force)
+    return bake
+
+
+def bake_world(scene, cache_dir=None, progress=None, force=False, settings=None):
+    """Bake (or find cached) the environment of ``scene``'s World: an ``EnvironmentBake``, or None when
+    the world has no usable image (``world_setup`` says why).  Files ``<image>_<hash12>_*`` in
+    ``cache_dir`` (default ``default_cache_dir()``); ``progress(stage, done, total)`` as in core;
+    ``settings``: ``PrefilterSettings`` (default: the measured defaults)."""
+    job = bake_job(scene, cache_dir, force, settings)
+    return job(progress) if job is not None else None
 
 
 # --- the "RTL World" group ----------------------------------------------------------------------------

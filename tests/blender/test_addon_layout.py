@@ -156,7 +156,8 @@ def test_preferences_draw_lists_every_table(bpy_module, tmp_path):
     for status in statuses:
         assert ("label", status.name, preferences.STATE_ICONS["missing"]) in labels
     assert ("prop", "lut_directory") in calls
-    assert calls[-1][:2] == ("operator", "rtl.lut_status")
+    assert calls[-2][:2] == ("operator", "rtl.lut_status") and calls[-1][:2] == ("operator", "rtl.bake_luts")
+    assert ("prop", "environment_cache") in calls
     for call in calls:
         if call[0] in ("label", "operator"):
             assert call[-1] in valid_icons | {'NONE'}, call

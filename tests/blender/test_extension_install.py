@@ -11,7 +11,7 @@ from rt_lookdev.validation import extension_zip as build_extension
 from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
-OPERATORS = ["add_node_groups", "add_path_traced_twin", "convert_to_principled", "convert_to_rt_lit", "export_luts",
+OPERATORS = ["add_node_groups", "add_path_traced_twin", "bake_luts", "convert_to_principled", "convert_to_rt_lit", "export_luts",
              "export_scene", "lut_status", "new_lookdev_scene", "sync_lights", "sync_world"]
 
 pytestmark = pytest.mark.blender
@@ -48,6 +48,10 @@ prefs = bpy.context.preferences.addons[MODULE].preferences
 result["prefs_class"] = type(prefs).__name__
 result["prefs_bl_idname"] = type(prefs).bl_idname
 result["prefs_lut_directory"] = prefs.lut_directory
+cache = installed.parent.parent / "chosen cache"     # inside the sandboxed user directory
+prefs.environment_cache = str(cache)
+result["env_cache"] = [str(cache), str(sys.modules[MODULE + ".addon.world_sync"].default_cache_dir())]
+prefs.environment_cache = ""
 
 result["poll"] = bpy.ops.rtl.lut_status.poll()
 print("RTL_OPERATOR_CALL_START", flush=True)
@@ -158,6 +162,8 @@ def test_install_enable_run_disable_leaves_nothing_behind(extension_zip, tmp_pat
     assert result["prefs_bl_idname"] == MODULE
     assert result["prefs_class"] == "RTL_AddonPreferences"
     assert result["prefs_lut_directory"] == ""
+    chosen, used = result["env_cache"]           # the preference "Environment Cache" is where worlds bake
+    assert used == chosen and Path(chosen).is_dir()
 
     assert result["poll"] is True
     assert result["lut_status"] == ["FINISHED"]
