@@ -7,7 +7,7 @@ Registration reads no file (it only checks that the preset library exists, to li
 """
 import bpy
 
-from . import (compat, convert, export_operators, light_sync, lookdev_operators, operators, preferences, presets,
+from . import (compat, convert, export_operators, light_sync, lookdev_operators, operators, preferences, preset_assets,
                switches, ui)
 
 classes = (
@@ -34,11 +34,11 @@ def register():
         menu.append(draw)
     switches.register()
     light_sync.register()
-    presets.register_library()
+    preset_assets.register_library()
 
 
 def unregister():
-    presets.unregister_library()
+    preset_assets.unregister_library()
     light_sync.unregister()
     switches.unregister()
     for menu, draw in reversed(menus):

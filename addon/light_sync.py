@@ -1,7 +1,7 @@
 """Lights in sync without a button: a depsgraph handler that re-syncs the RT Lit groups when the scene's
 shaded lights change (a light added, removed, hidden from renders, moved to an excluded collection, or an
 area light changing shape), and converts a lookdev preset to RT Lit when it is first used
-(``presets.convert_pending``: a preset dropped from the Asset Browser).
+(``preset_assets.convert_pending``: a preset dropped from the Asset Browser).
 
 Moving and editing a light needs no sync: drivers carry its transform and data into the groups, with
 Python auto-run off too.  The handler only compares the lights' signature (name, kind, shape:
@@ -14,7 +14,7 @@ from __future__ import annotations
 import bpy
 from bpy.app.handlers import persistent
 
-from . import materials, preferences, presets
+from . import materials, preferences, preset_assets as presets
 
 #: Update kinds (datablock types) that can change which lights a scene shades, or assign a preset.
 _RELEVANT = (bpy.types.Object, bpy.types.Collection, bpy.types.Light, bpy.types.Scene, bpy.types.Material)

@@ -3,7 +3,7 @@ New Lookdev Scene, and Add Path-Traced Twin of the active lookdev scene."""
 from __future__ import annotations
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from . import lookdev_scene, preferences
 from .convert import DIFFUSE_ITEMS, SPECULAR_ITEMS
@@ -34,6 +34,8 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
         items=(("AgX", "AgX", "Blender's default display transform"),
                ("Standard", "Standard", "No tone mapping: the values the measurements compare")),
         default="AgX")
+    floor: BoolProperty(name="Floor", default=False,
+                        description="A grey RT Lit floor under the spheres (RT Lit casts no shadows on it)")
     specular: EnumProperty(name="Specular", items=SPECULAR_ITEMS, default=Features().specular)
     diffuse: EnumProperty(name="Diffuse", items=DIFFUSE_ITEMS, default=Features().diffuse)
 
@@ -60,7 +62,7 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
             scene = lookdev_scene.new_lookdev_scene(
                 self.scene_name or "RT Lookdev", Features(specular=self.specular, diffuse=self.diffuse),
                 hdri=hdri, world_strength=self.world_strength, view_transform=self.view_transform,
-                lut_dir=preferences.lut_directory(context),
+                lut_dir=preferences.lut_directory(context), floor=self.floor,
                 progress=(lambda done, total: wm.progress_update(done / total)) if show else None)
         except Exception as ex:
             self.report({'ERROR'}, f"Could not build the lookdev scene: {type(ex).__name__}: {ex}")
@@ -72,7 +74,7 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
             context.window.scene = scene
         spheres = len(lookdev_scene.lookdev_spheres(scene))
         world = f"world '{hdri}'" if hdri else "no world"
-        self.report({'INFO'}, f"Lookdev scene '{scene.name}': {spheres} RT Lit spheres, 3 lights, {world}; "
+        self.report({'INFO'}, f"Lookdev scene '{scene.name}': {spheres} RT Lit objects, 3 lights, {world}; "
                               "Add > Path-Traced Twin compares it with Cycles path tracing")
         return {'FINISHED'}
 

@@ -168,13 +168,44 @@ def configure_lookdev_render(scene, view_transform="AgX", samples=16):
     scene.view_settings.look = "None"
 
 
+#: The floor's material and switches: grey, rough, the cheapest lobes.
+FLOOR_VALUES = {"Base Color": (0.5, 0.5, 0.5, 1.0), "Roughness": 0.8, "Metallic": 0.0}
+FLOOR_FEATURES = {"specular": "single", "diffuse": "lambert"}
+#: With a floor the camera looks down by this much (radians), so the floor is seen.
+FLOOR_CAMERA_TILT = math.radians(15.0)
+
+
+def _floor(name, collection, z, lut_dir, scene):
+    """A 9 x 5 m plane under the spheres with an RT Lit material (where RT Lit's missing shadows show)."""
+    import bmesh
+
+    from ..core.materials.rt_lit_interface import Features
+    from . import convert, materials
+
+    mat = principled_material(f"{name} Floor", FLOOR_VALUES)
+    convert.principled_to_rt_lit(mat, lambda f: materials.ensure_rt_lit_group(f, scene, lut_dir),
+                                 Features(**FLOOR_FEATURES))
+    mesh = bpy.data.meshes.new(f"{name} Floor")
+    bm = bmesh.new()
+    bmesh.ops.create_grid(bm, x_segments=1, y_segments=1, size=1.0)
+    bmesh.ops.scale(bm, vec=(4.5, 2.5, 1.0), verts=bm.verts)
+    bm.to_mesh(mesh)
+    bm.free()
+    mesh.materials.append(mat)
+    obj = bpy.data.objects.new(f"{name} Floor", mesh)
+    obj.location = (0.0, 0.0, z)
+    collection.objects.link(obj)
+    return obj
+
+
 def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world_strength=1.0,
-                      view_transform="AgX", lut_dir=None, resolution=(960, 480), progress=None):
+                      view_transform="AgX", lut_dir=None, resolution=(960, 480), progress=None, floor=False):
     """Build the lookdev scene (see the module doc) as a new scene of the current file; returns it.
 
     ``features``: the RT Lit switches (``Features``; default ``Features()``); ``hdri``: a studio HDRI name
     (``core.environment.equirect.studio_hdris``) or an EXR path, None for no world; ``progress(done,
-    total)`` is called after each step (the world bake, each material)."""
+    total)`` is called after each step (the world bake, each material); ``floor``: a grey RT Lit floor under
+    the spheres, and the camera tilted to see it (RT Lit casts no shadows on it: README, "Limits")."""
     from ..core.materials.rt_lit_interface import Features
     from . import convert, materials
     from . import world_sync as rtl_world
@@ -217,9 +248,13 @@ def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world
             sphere(f"{name} {object_name}", (x0 + col * SPACING, 0.0, z), mat, collection)
             advance()
 
-    cam = ortho_camera(f"{name} Camera", (0.0, -10.0, 0.0), (0.5 * math.pi, 0.0, 0.0),
-                       SPACING * len(ROUGHNESS) + 0.1, collection)
+    tilt = FLOOR_CAMERA_TILT if floor else 0.0
+    cam = ortho_camera(f"{name} Camera", (0.0, -10.0 * math.cos(tilt), 10.0 * math.sin(tilt)),
+                       (0.5 * math.pi - tilt, 0.0, 0.0), SPACING * len(ROUGHNESS) + 0.1, collection)
     scene.camera = cam
+    if floor:
+        bottom = 0.5 * SPACING * (len(ROWS) - 1) - (len(ROWS) - 1) * SPACING - RADIUS
+        _floor(name, collection, bottom, lut_dir, scene)
     return scene
 
 

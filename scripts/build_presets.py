@@ -1,4 +1,4 @@
-"""Build the lookdev preset asset library (``rt_lookdev.addon.presets``): ``assets/rt_lookdev_presets.blend``
+"""Build the lookdev preset asset library (``rt_lookdev.addon.preset_assets``): ``assets/rt_lookdev_presets.blend``
 and ``assets/blender_assets.cats.txt`` from ``core/materials/presets.py``.
 
     python scripts/build_presets.py [--out assets]
@@ -14,7 +14,7 @@ def main(argv):
         argv = argv[argv.index("--") + 1:]
     import bpy
 
-    from rt_lookdev.addon import presets
+    from rt_lookdev.addon import preset_assets as presets
     from rt_lookdev.core.materials import presets as core_presets
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

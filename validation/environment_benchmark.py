@@ -128,11 +128,14 @@ def large_source_rows(tmp, default_cap, log=print):
 CHECK_R = (0.125, 0.5, 1.0)
 
 
-def hdri_rows(normals, dirs, settings, tmp, log=report.flush_log):
-    """Per studio HDRI: (name, SH irradiance mean / p90 / max relative error, SH bake s, prefiltered
-    bake s, cached re-run s), and (name, [relative errors of the prefiltered lookup per ``CHECK_R``])."""
+def hdri_rows(normals, dirs, settings, tmp, log=report.flush_log, names=None):
+    """Per studio HDRI (``names``: a subset): (name, SH irradiance mean / p90 / max relative error, SH bake s,
+    prefiltered bake s, cached re-run s), and (name, [relative errors of the prefiltered lookup per
+    ``CHECK_R``])."""
     rows, pf_rows = [], []
     for name, path in equirect.studio_hdris().items():
+        if names and name not in names:
+            continue
         rng = np.random.default_rng(2024)
         image = equirect.read_equirect(path)
         normals_ = _unit(rng, normals)
@@ -282,6 +285,9 @@ def parse_args(argv):
     p.add_argument("--normals", type=int, default=500)
     p.add_argument("--dirs", type=int, default=128, help="random directions for the prefilter check")
     p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks" / "environment.md")
+    p.add_argument("--hdris", default="", help="comma-separated studio HDRIs (default: all 8)")
+    p.add_argument("--quick", action="store_true",
+                   help="smoke run: skip the large-source and sampling-method sections (most of the ~10 minutes)")
     return p.parse_args(argv)
 
 
@@ -289,11 +295,13 @@ def run(args, log=report.flush_log):
     """Measure, write ``args.out`` (Markdown) and the JSON beside it; returns the JSON's dict."""
     settings = prefilter.PrefilterSettings()
     with tempfile.TemporaryDirectory() as tmp:
-        rows, pf_rows = hdri_rows(args.normals, args.dirs, settings, tmp, log)
-        large_runs, large_diff = large_source_rows(tmp, settings.max_source_width, log)
-    method = method_rows(log)
-    md = (_markdown_hdris(args.normals, settings, rows) + _markdown_prefiltered(args.dirs, settings, pf_rows)
-          + _markdown_method(method) + _markdown_large(settings, large_runs, large_diff))
+        names = [n for n in args.hdris.split(",") if n]
+        rows, pf_rows = hdri_rows(args.normals, args.dirs, settings, tmp, log, names)
+        large_runs, large_diff = ([], []) if args.quick else large_source_rows(tmp, settings.max_source_width, log)
+    method = [] if args.quick else method_rows(log)
+    md = _markdown_hdris(args.normals, settings, rows) + _markdown_prefiltered(args.dirs, settings, pf_rows)
+    if not args.quick:
+        md += _markdown_method(method) + _markdown_large(settings, large_runs, large_diff)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text("\n".join(md) + "\n")
     results = _results(rows, pf_rows, large_runs, large_diff)

@@ -5,8 +5,8 @@
     ``render_setup``: the value of each pixel is exact);
 (b) the twin, Cycles path tracing of the Principled materials at ``samples`` per pixel, two seeds (their
     half-difference is the reference's own noise), with the same pixel-centre filter, 0 bounces;
-(c) the twin again with the spheres' shadows off (``Object.visible_shadow``), so the error splits into what
-    RT Lit approximates and the shadows it does not cast,
+(c) the twin again with the spheres seen by camera rays only (``RAY_VISIBILITY`` off), so the error splits
+    into what RT Lit approximates and the shadows (and occlusion of the world) it does not compute,
 and, where EEVEE can render, (d) the lookdev scene in EEVEE against (a).
 Per sphere (the Object Index pass; silhouette pixels, where a pixel centre may fall on either side of the
 edge, left out): the relative error of each channel where the reference is above 1% of that sphere's
@@ -27,6 +27,10 @@ from . import exr_images
 
 #: Reference values below this fraction of the sphere's maximum are not compared (the suite's floor).
 FLOOR_FRACTION = 0.01
+#: The ray visibilities turned off for "without shadows": a shadow ray alone is not enough, since with
+#: multiple importance sampling the BSDF-sampled rays towards the world would still be blocked.
+RAY_VISIBILITY = ("visible_shadow", "visible_diffuse", "visible_glossy", "visible_transmission",
+                  "visible_volume_scatter")
 
 
 @contextlib.contextmanager
@@ -142,14 +146,16 @@ def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee
         index = np.where(ref_index == index, index, 0)     # both renders must show the same object
         result["with_shadows"] = sphere_errors(a, refs, index, names)
         twin_spheres = list(twins.values())
-        saved = [o.visible_shadow for o in twin_spheres]
+        saved = [{a: getattr(o, a) for a in RAY_VISIBILITY} for o in twin_spheres]
         try:
-            for o in twin_spheres:
-                o.visible_shadow = False
+            for o in twin_spheres:           # seen by the camera only: no shadow, no occlusion of the world
+                for attr in RAY_VISIBILITY:
+                    setattr(o, attr, False)
             unshadowed = [render_measurement(twin, resolution, samples, seed, tmp)[0] for seed in seeds]
         finally:
-            for o, flag in zip(twin_spheres, saved):
-                o.visible_shadow = flag
+            for o, flags in zip(twin_spheres, saved):
+                for attr, flag in flags.items():
+                    setattr(o, attr, flag)
         result["without_shadows"] = sphere_errors(a, unshadowed, index, names)
         shadow_mean = 0.5 * (refs[0] + refs[1])
         free_mean = 0.5 * (unshadowed[0] + unshadowed[1])
@@ -159,6 +165,7 @@ def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee
         result["seconds"] = {"rt_lit_cycles": t_a, "path_traced": float(np.median(times))}
         if eevee:
             result["eevee"] = _eevee_against_cycles(scene, resolution, a, index, tmp, log)
+        result["index"] = index
         result["images"] = {"rt_lit": a.astype(np.float32), "path_traced": shadow_mean.astype(np.float32),
                             "path_traced_no_shadows": free_mean.astype(np.float32)}
     return result
@@ -206,6 +213,14 @@ def format_markdown(result):
                      f"{'' if noise is None else f'{noise:.2%}'} |")
     lines += ["", f"Pixels darkened by more than 5% by the spheres' shadows in the path-traced twin: "
                   f"{result['shadowed_fraction']:.1%} (RT Lit casts no shadows)."]
+    f = result.get("floor")
+    if f:
+        lines.append(f"With the floor (`new_lookdev_scene(floor=True)`, {f['samples']} spp): the spheres' shadows "
+                     f"darken {f['floor_shadowed_fraction']:.1%} of the floor's pixels by more than 5% in path "
+                     f"tracing; RT Lit's floor error is {f['floor_with_shadows']['median']:.2%} median / "
+                     f"{f['floor_with_shadows']['p90']:.2%} p90 against it, and "
+                     f"{f['floor_without_shadows']['median']:.2%} / {f['floor_without_shadows']['p90']:.2%} with the "
+                     "spheres' shadows off.")
     e = result.get("eevee")
     if e and "skipped" not in e:
         lines.append(f"EEVEE vs Cycles (RT Lit): median {e['median']:.2e}, p99 {e['p99']:.2e} relative over "
@@ -260,6 +275,37 @@ def write_pictures(result, folder, prefix="lookdev_"):
     return paths
 
 
+def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print):
+    """The lookdev scene with its floor (``new_lookdev_scene(floor=True)``) against its twin: how much of the
+    floor the spheres shadow in path tracing, and the error that leaves on it (RT Lit casts no shadows)."""
+    import bpy
+
+    from ..addon import lookdev_scene
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = lookdev_scene.new_lookdev_scene("Floor Study", view_transform="Standard", lut_dir=lut_dir, floor=True)
+    twin = lookdev_scene.add_path_traced_twin(scene)
+    result = compare(scene, twin, resolution, samples, eevee=False, log=log)
+    floor = f"{scene.name} Floor"
+    index = result["spheres"].index(floor) + 1
+    out = {"resolution": list(resolution), "samples": samples,
+           "floor_with_shadows": result["with_shadows"].get(floor), "floor_without_shadows": result["without_shadows"].get(floor),
+           "shadowed_fraction_all": result["shadowed_fraction"], "images": result["images"]}
+    shadowed = result["images"]["path_traced"].max(axis=-1)
+    free = result["images"]["path_traced_no_shadows"].max(axis=-1)
+    floor_mask = _floor_mask(result, index)
+    darkened = (free - shadowed)[floor_mask] / np.maximum(free[floor_mask], 1e-12)
+    out["floor_shadowed_fraction"] = float((darkened > 0.05).mean()) if darkened.size else 0.0
+    log(f"[twin] floor study: {out['floor_shadowed_fraction']:.1%} of the floor darkened > 5% by shadows; floor "
+        f"median error {out['floor_with_shadows']['median']:.2%} with, {out['floor_without_shadows']['median']:.2%} "
+        "without the shadows")
+    return out
+
+
+def _floor_mask(result, index):
+    return _interior(result["index"]) & (result["index"] == index)
+
+
 def run(out_dir, lut_dir=None, resolution=(320, 160), samples=256, eevee=True, pictures_dir=None, log=print):
     """Build the lookdev scene in a fresh file (``new_lookdev_scene``, Standard view transform), add its twin,
     measure them (``compare``) and write ``out_dir``/lookdev.{md,json} and the PNGs (also into
@@ -280,11 +326,17 @@ def run(out_dir, lut_dir=None, resolution=(320, 160), samples=256, eevee=True, p
     result["seconds"]["build"] = build
     result["checks"] = checks(result)
     result["passed"] = all(result["checks"].values())
+    result.pop("index")
+    floor = shadow_study(lut_dir, log=log)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     pictures = write_pictures(result, out_dir)
+    pictures += write_pictures(floor, out_dir, prefix="lookdev_floor_")
     if pictures_dir is not None:
         write_pictures(result, pictures_dir)
+        write_pictures(floor, pictures_dir, prefix="lookdev_floor_")
+    floor.pop("images")
+    result["floor"] = floor
     result["pictures"] = [p.name for p in pictures]
     images = result.pop("images")
     result["summary_markdown"] = format_markdown(result)

@@ -150,13 +150,14 @@ def _renders(features, count, repeats=1, world=NO_WORLD, detail=False):
     return result + ({"svm_overflow": SVM_OVERFLOW in "".join(log)},) if detail else result
 
 
-def capacity(features, world=NO_WORLD, hint=None, log=print, checks=None):
-    """(largest N <= MAX_LIGHTS whose material renders, capped at MAX_LIGHTS).  Without world the
+def capacity(features, world=NO_WORLD, hint=None, log=print, checks=None, max_lights=None):
+    """(largest N <= max_lights (default MAX_LIGHTS) whose material renders, capped at max_lights).  Without world the
     search starts at 1 light (0 lights light nothing), with the World term at 0 lights; N is one less
     than that start (0, or -1: the World term alone does not fit) when the start fails.  ``hint``: a
     likely answer (the capacity without world), tried first, then hint + 1 or hint - 1, -2, -4, ...
     Assumes more lights never fit when fewer do not.  ``checks`` (a dict): filled with
     {N: (renders, svm_overflow logged)}."""
+    cap = MAX_LIGHTS if max_lights is None else max_lights
     works = {} if checks is None else checks
 
     def ok(n):
@@ -169,7 +170,7 @@ def capacity(features, world=NO_WORLD, hint=None, log=print, checks=None):
     if not ok(lo):
         return lo - 1, False
     hi = None
-    if hint is not None and lo < hint <= MAX_LIGHTS:
+    if hint is not None and lo < hint <= cap:
         if ok(hint):
             lo = hint
         else:                        # gallop down from the hint
@@ -178,9 +179,9 @@ def capacity(features, world=NO_WORLD, hint=None, log=print, checks=None):
                 hi, step = hi - step, step * 2
             lo = max(lo, hi - step)
     while hi is None:                # ok(lo): grow (lo + 1 right after a hint, else doubling)
-        if lo >= MAX_LIGHTS:
-            return MAX_LIGHTS, True
-        nxt = lo + 1 if lo == hint else min(max(2 * lo, 1), MAX_LIGHTS)
+        if lo >= cap:
+            return cap, True
+        nxt = lo + 1 if lo == hint else min(max(2 * lo, 1), cap)
         lo, hi = (nxt, None) if ok(nxt) else (lo, nxt)
     while hi - lo > 1:               # ok(lo), not ok(hi)
         mid = (lo + hi) // 2
@@ -272,12 +273,12 @@ def _timing_configs(most, n):
     return list(dict.fromkeys(configs))
 
 
-def measure(features, reps):
+def measure(features, reps, max_lights=None):
     """One row of the report: capacities without and with the World term, render times, node counts."""
     t0 = time.perf_counter()
     checks, world_checks = {}, {}
-    most, capped = capacity(features, checks=checks)
-    world_most, world_capped = capacity(features, WORLD_TERM, hint=most, checks=world_checks)
+    most, capped = capacity(features, checks=checks, max_lights=max_lights)
+    world_most, world_capped = capacity(features, WORLD_TERM, hint=most, checks=world_checks, max_lights=max_lights)
     t1 = time.perf_counter()
     n = world_most
     t = timed(features, _timing_configs(most, n), reps)
@@ -390,21 +391,25 @@ def parse_args(argv):
     p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks")
     p.add_argument("--repeats", type=int, default=3, help="interleaved rounds per timing (median)")
     p.add_argument("--only", action="append", help="only the feature sets whose label contains this (repeatable)")
+    p.add_argument("--quick", action="store_true",
+                   help="smoke run: single + Lambert only, capacities searched up to 2 lights, 1 round")
     return p.parse_args(argv)
 
 
 def run(args, log=report.flush_log):
     """Measure every feature set, write rt_lit.json and rt_lit.md to ``args.out``; returns the JSON's dict."""
-    reps = args.repeats
+    quick = getattr(args, "quick", False)
+    reps = 1 if quick else args.repeats
+    max_lights = 2 if quick else MAX_LIGHTS
     rows = []
     t_start = time.perf_counter()
-    for features in feature_sets(args.only):
-        rows.append(measure(features, reps))
+    for features in feature_sets(args.only or (["single, lambert"] if quick else None)):
+        rows.append(measure(features, reps, max_lights))
         log(str(rows[-1]))
     total = round(time.perf_counter() - t_start, 1)
     args.out.mkdir(parents=True, exist_ok=True)
     result = {"resolution": list(RESOLUTION), "samples": 1, "repeats": reps, "hdri": HDRI,
-              "world_strength": WORLD_STRENGTH, "max_lights": MAX_LIGHTS, "total_seconds": total,
+              "world_strength": WORLD_STRENGTH, "max_lights": max_lights, "total_seconds": total,
               "cycles_threads": _threads(), "rows": rows}
     (args.out / "rt_lit.json").write_text(json.dumps(result, indent=2))
     lines = _markdown_capacity(rows, reps) + _markdown_world_time(rows) + _markdown_node_counts(rows, total)

@@ -5,7 +5,7 @@ Metals: Base Color = F0 in linear sRGB, the measured values tabulated by Unity's
 ("Metal Reflectance Node", after Hoffman 2015, "Physics and Math of Shading", SIGGRAPH course); the project's
 Fresnel is Schlick's with F90 = 1 (docs/conventions.md).  Dielectrics use Principled's default IOR 1.5
 (F0 = 0.04) unless stated.  Each preset names the technique it shows off (the switches of
-``rt_lit_interface.Features``).  No bpy here: the Blender side is ``addon/presets.py``.
+``rt_lit_interface.Features``).  No bpy here: the Blender side is ``addon/preset_assets.py``.
 """
 from __future__ import annotations
 

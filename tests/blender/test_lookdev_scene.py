@@ -99,6 +99,7 @@ def test_rt_lit_against_the_path_traced_twin(lookdev):
     assert pooled["values"] > 5000
     # the twin is a measurement, not a copy: the reference has its own noise and RT Lit differs by more
     assert 0.0 < pooled["noise_median"] < pooled["median"]
-    assert 0.0 <= result["shadowed_fraction"] < 0.05
+    # the spheres stand apart: a few percent of their pixels see a neighbour (3.7% at 320 x 160, 256 spp)
+    assert 0.0 <= result["shadowed_fraction"] < 0.10
     images = result["images"]
     assert np.isfinite(images["rt_lit"]).all() and images["rt_lit"].max() > 0.05

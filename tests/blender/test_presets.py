@@ -1,4 +1,4 @@
-"""The lookdev presets as assets (addon/presets.py, core/materials/presets.py, assets/)."""
+"""The lookdev presets as assets (addon/preset_assets.py, core/materials/presets.py, assets/)."""
 import numpy as np
 import pytest
 
@@ -6,7 +6,7 @@ pytestmark = pytest.mark.blender
 
 
 def _load_library(bpy, names=None):
-    from rt_lookdev.addon import presets
+    from rt_lookdev.addon import preset_assets as presets
 
     with bpy.data.libraries.load(str(presets.LIBRARY_FILE), link=False, assets_only=True) as (src, dst):
         dst.materials = list(src.materials) if names is None else list(names)
@@ -16,7 +16,7 @@ def _load_library(bpy, names=None):
 def test_shipped_library_holds_every_preset_with_its_catalog(bpy_module, empty_scene):
     """The .blend and the catalog file in assets/ are what scripts/build_presets.py makes from the core's list
     (rebuild them after editing core/materials/presets.py)."""
-    from rt_lookdev.addon import presets
+    from rt_lookdev.addon import preset_assets as presets
     from rt_lookdev.core.materials import presets as core_presets
 
     assert presets.CATALOG_FILE.read_text() == presets.catalog_text()
@@ -35,7 +35,7 @@ def test_shipped_library_holds_every_preset_with_its_catalog(bpy_module, empty_s
 
 def test_enabling_the_extension_lists_the_library_in_the_asset_browser(bpy_module, empty_scene):
     import rt_lookdev
-    from rt_lookdev.addon import presets
+    from rt_lookdev.addon import preset_assets as presets
 
     libraries = bpy_module.context.preferences.filepaths.asset_libraries
 
@@ -64,7 +64,8 @@ def _render(bpy, scene):
 def test_a_dropped_preset_becomes_an_rt_lit_material_that_renders_as_one_converted_in_the_scene(registered, empty_scene):
     """Appending a preset and assigning it converts it at the next depsgraph update, for the scene's lights
     and world: it renders exactly as the same Principled values converted in the scene with the same switches."""
-    from rt_lookdev.addon import convert, lookdev_scene, materials, presets
+    from rt_lookdev.addon import convert, lookdev_scene, materials
+    from rt_lookdev.addon import preset_assets as presets
     from rt_lookdev.core.materials import presets as core_presets
 
     bpy = registered
@@ -98,7 +99,7 @@ def test_a_dropped_preset_becomes_an_rt_lit_material_that_renders_as_one_convert
 
 def test_presets_in_the_library_file_itself_are_not_converted(registered, empty_scene):
     """Only presets in use are converted: the library's own materials (fake users) stay Principled."""
-    from rt_lookdev.addon import presets
+    from rt_lookdev.addon import preset_assets as presets
 
     loaded = _load_library(registered)
     registered.context.view_layer.update()
