@@ -78,8 +78,17 @@ def render_measurement(scene, resolution, samples, seed, folder):
         seconds = time.perf_counter() - t0
     ch = exr_images.read_channels(exr)
     rgb = exr_images.find_pass(ch, "Combined", "RGB").astype(np.float64)
-    index = np.rint(exr_images.find_pass(ch, "Object Index", "X")[..., 0]).astype(int)
+    index = np.rint(_object_index(ch)[..., 0]).astype(int)
     return rgb, index, seconds
+
+
+def _object_index(channels):
+    """The Object Index pass: "IndexOB" in the EXR of Blender 4.5, "Object Index" from 5.0 on (measured with
+    the pinned wheels)."""
+    try:
+        return exr_images.find_pass(channels, "Object Index", "X")
+    except KeyError:
+        return exr_images.find_pass(channels, "IndexOB", "X")
 
 
 def _interior(index):
