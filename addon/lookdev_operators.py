@@ -7,6 +7,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, St
 
 from . import lookdev_scene, preferences
 from .convert import DIFFUSE_ITEMS, SPECULAR_ITEMS
+from .operators import _lut_directory_exists
 from ..core.materials.rt_lit_interface import Features
 
 
@@ -41,11 +42,7 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        lut_dir = preferences.lut_directory(context)
-        if not lut_dir.is_dir():
-            cls.poll_message_set(f"LUT directory does not exist: {lut_dir}")
-            return False
-        return True
+        return _lut_directory_exists(cls, context)
 
     def invoke(self, context, event):
         if "studio" in lookdev_scene.studio_hdris():
