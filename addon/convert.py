@@ -33,7 +33,8 @@ from bpy.props import BoolProperty, EnumProperty
 
 from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, RT_LIT_INPUTS, SPECULAR_MODELS,
                                                Features)
-from .common import FEATURES_KEY, RT_LIT_NODE_NAME
+from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, connect_engine_outputs, not_a_light, restore_emission_sampling,
+                     restore_engine_outputs)
 
 #: Principled BSDF input -> RT Lit input (same names).  "Normal" is link-only.
 MAPPED_INPUTS = (
@@ -435,6 +436,8 @@ def principled_to_rt_lit(material, group_factory, features=None):
     if rt is not None:  # already RT Lit: only the switches may change
         group = group_factory(features)
         swapped = _swap_group(tree, rt, group)
+        connect_engine_outputs(tree, rt, output)
+        not_a_light(material)
         changed = swapped or stored_features(material) != features
         _store_features(material, features)
         rt.label = f"RT Lit ({features.label()})"
@@ -486,8 +489,10 @@ def principled_to_rt_lit(material, group_factory, features=None):
                     pass
         del material[RT_ONLY_VALUES_PROP]
 
-    # the group's Shader output is the emission of every light (one closure per light)
-    tree.links.new(rt.outputs[RT_LIT_OUTPUT], output.inputs["Surface"])  # replaces the BSDF link
+    # the group's Shader output is the emission of every light (one closure per light), Cycles' tree;
+    # "EEVEE Shader" feeds an EEVEE Material Output (replaces the BSDF link)
+    connect_engine_outputs(tree, rt, output)
+    not_a_light(material)
 
     # Keep the Principled node, collapsed in a labelled frame below the RT Lit node.
     frame = tree.nodes.new("NodeFrame")
@@ -581,6 +586,8 @@ def rt_lit_to_principled(material):
                                f"RT Lit inputs {', '.join(dropped)}; their links are dropped")
 
     _remove_rt_lit_nodes(tree, rt)
+    output = restore_engine_outputs(tree) or output
+    restore_emission_sampling(material)
     tree.links.new(principled.outputs["BSDF"], output.inputs["Surface"])
     return result
 

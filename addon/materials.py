@@ -20,7 +20,7 @@ import math
 import bpy
 
 from ..core import lights as core_lights
-from ..core.ir.expr import FLOAT
+from ..core.ir.expr import FLOAT, table_filter
 from ..core.ir.interface import Socket
 from ..core.lut.lookup import LutSet
 from ..core.materials import rt_lit
@@ -28,8 +28,9 @@ from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, R
                                                Features, light_input, rt_lit_group_name)
 from . import compat, node_emit, world_sync
 from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LIGHTS_SIGNATURE_KEY, RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME,
-                     SCENE_LIGHTS_GROUP,
-                     WORLD_GROUP, add_driver, ensure_interface, remove_drivers, socket_by_identifier)
+                     SCENE_LIGHTS_GROUP, STAMP_KEY,
+                     WORLD_GROUP, add_driver, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers,
+                     socket_by_identifier)
 
 _AREA_SHAPES = {"SQUARE": "quad", "RECTANGLE": "quad", "DISK": "disk", "ELLIPSE": "disk"}
 #: Geometry node output feeding each geometry input of the material function.
@@ -221,8 +222,28 @@ class _TreeInputs:
         return make
 
 
+#: RT Lit's tree per render engine: (engine, Material Output target, table filter, output prefix).  Cycles'
+#: Image Texture with Linear interpolation is the exact bilinear filter of the tables (one node per
+#: lookup); EEVEE's picks mipmaps from screen-space derivatives, so its tree writes the filter out as
+#: four Closest fetches (core.ir.tables.bilinear_function).  docs/blender.md, "Per-engine trees".
+ENGINE_TREES = (("Cycles", "CYCLES", "linear", ""), ("EEVEE", "EEVEE", "fetch4", "EEVEE "))
+ENGINE_STAMP_KEY = "rtl_engine_trees"
+
+
+def engine_tree_name(features, engine):
+    """Name of the RT Lit tree of ``features`` for ``engine`` ("Cycles" / "EEVEE")."""
+    return f"{rt_lit_group_name(features)} [{engine}]"
+
+
+def engine_output(engine, output="Shader"):
+    """The RT Lit group's output that carries ``output`` ("Shader", "Radiance") of ``engine``'s tree."""
+    return next(prefix for name, _, _, prefix in ENGINE_TREES if name == engine) + output
+
+
 def ensure_rt_lit_group(features=None, scene=None, lut_dir=None):
-    """The RT Lit group for ``features`` and the lights of ``scene`` (built or reused)."""
+    """The RT Lit group for ``features`` and the lights of ``scene`` (built or reused): the material
+    inputs as its interface, one nested tree per engine (``ENGINE_TREES``) fed by them, and each tree's
+    outputs ("Shader", "Radiance" for Cycles; "EEVEE Shader", "EEVEE Radiance")."""
     features = features or Features()
     scene = scene or bpy.context.scene
     if bpy.data.node_groups.get(SCENE_LIGHTS_GROUP) is None:
@@ -230,19 +251,74 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None):
     records = synced_light_kinds()
     world = world_sync.world_environment()
     env, world_record = world if world is not None else (None, None)
-    material = rt_lit.build_rt_lit(features, tuple(kind for _, kind in records), env)
-
-    inputs = _TreeInputs()
-    internal = {name: inputs.geometry(_GEOMETRY_SOCKETS[name]) for name in GEOMETRY_INPUTS}
-    for per_light in material.light_inputs:
-        internal.update({name: inputs.group("lights", SCENE_LIGHTS_GROUP, -200.0, name) for name in per_light.values()})
-    internal.update({name: inputs.group("world", WORLD_GROUP, -600.0, name) for name in material.world_inputs.values()})
-    ng, _ = node_emit.ensure_tree(rt_lit_group_name(features), material.function, material.material_inputs,
-                                  sockets=(RT_LIT_INPUTS, RT_LIT_OUTPUTS), internal_inputs=internal,
-                                  stamp_extra=repr((records, world_record and world_record["table"])),
-                                  tables=_tables(lut_dir, env),
-                                  shader_sums={"Shader": list(material.part_outputs)})
+    tables = _tables(lut_dir, env)
+    trees, material_inputs = {}, None
+    for engine, _, table_filter_mode, _ in ENGINE_TREES:
+        with table_filter(table_filter_mode):
+            material = rt_lit.build_rt_lit(features, tuple(kind for _, kind in records), env)
+        inputs = _TreeInputs()
+        internal = {name: inputs.geometry(_GEOMETRY_SOCKETS[name]) for name in GEOMETRY_INPUTS}
+        for per_light in material.light_inputs:
+            internal.update({name: inputs.group("lights", SCENE_LIGHTS_GROUP, -200.0, name)
+                             for name in per_light.values()})
+        internal.update({name: inputs.group("world", WORLD_GROUP, -600.0, name) for name in material.world_inputs.values()})
+        trees[engine], _ = node_emit.ensure_tree(engine_tree_name(features, engine), material.function,
+                                                 material.material_inputs, sockets=(RT_LIT_INPUTS, RT_LIT_OUTPUTS),
+                                                 internal_inputs=internal,
+                                                 stamp_extra=repr((records, world_record and world_record["table"])),
+                                                 tables=tables, shader_sums={"Shader": list(material.part_outputs)})
+        material_inputs = material.material_inputs
+    ng = _ensure_engine_group(rt_lit_group_name(features), trees, material_inputs)
     ng[FEATURES_KEY] = features.as_dict()
+    return ng
+
+
+def engine_node_counts(ng):
+    """{engine: flattened Blender nodes of its tree} of an RT Lit group (``{"All": n}`` for a group
+    without engine trees)."""
+    trees = {n.name: n.node_tree for n in ng.nodes if n.bl_idname == "ShaderNodeGroup" and n.node_tree is not None
+             and n.name in {engine for engine, *_ in ENGINE_TREES}}
+    if not trees:
+        return {"All": node_emit.flat_tree_node_count(ng)}
+    return {engine: node_emit.flat_tree_node_count(tree) for engine, tree in trees.items()}
+
+
+def _ensure_engine_group(name, trees, material_inputs):
+    """The group artists see: interface = the material inputs, one Group node per engine tree, each
+    tree's outputs under its engine's prefix.  Kept when it already holds these trees (they are rebuilt
+    in place), so materials keep their links and values."""
+    ng = bpy.data.node_groups.get(name)
+    if ng is None:
+        ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    stamp = repr([(engine, tree.name) for engine, tree in trees.items()] + list(material_inputs))
+    wanted = [(engine_output(engine, out), "OUTPUT", RT_LIT_OUTPUTS[out].kind, RT_LIT_OUTPUTS[out])
+              for engine in trees for out in RT_LIT_OUTPUTS]
+    wanted += [(n, "INPUT", RT_LIT_INPUTS[n].kind, RT_LIT_INPUTS[n]) for n in material_inputs]
+    items = ensure_interface(ng, wanted)
+    # the group's stamp follows its trees' (they are rebuilt in place when their function changes)
+    ng[STAMP_KEY] = repr([(engine, tree.get(STAMP_KEY)) for engine, tree in trees.items()])
+    if ng.get(ENGINE_STAMP_KEY) == stamp and len(ng.nodes) == 2 + len(trees):
+        return ng
+    ng.nodes.clear()
+    ng.description = "RT Lit: the material inputs feed one tree per render engine (Cycles: Linear table " \
+                     "lookups; EEVEE: four exact texel fetches); connect Shader to a Cycles Material Output " \
+                     "and EEVEE Shader to an EEVEE one (assign_rt_lit does)"
+    group_in = ng.nodes.new("NodeGroupInput")
+    group_in.location = (-400.0, 0.0)
+    group_out = ng.nodes.new("NodeGroupOutput")
+    group_out.location = (400.0, 0.0)
+    for row, (engine, tree) in enumerate(trees.items()):
+        node = ng.nodes.new("ShaderNodeGroup")
+        node.node_tree = tree
+        node.name = node.label = engine
+        node.width = 240
+        node.location = (0.0, -row * 500.0)
+        for n in material_inputs:
+            ng.links.new(socket_by_identifier(group_in.outputs, items[(n, "INPUT")].identifier), node.inputs[n])
+        for out in RT_LIT_OUTPUTS:
+            target = socket_by_identifier(group_out.inputs, items[(engine_output(engine, out), "OUTPUT")].identifier)
+            ng.links.new(node.outputs[out], target)
+    ng[ENGINE_STAMP_KEY] = stamp
     return ng
 
 
@@ -263,7 +339,8 @@ def rebuild_rt_lit_groups(scene, lut_dir=None):
 
 
 def assign_rt_lit(material, features=None, scene=None, lut_dir=None):
-    """Make ``material`` an RT Lit material: RT Lit group (Shader) -> Material Output."""
+    """Make ``material`` an RT Lit material: the RT Lit group's "Shader" to a Material Output for Cycles
+    and its "EEVEE Shader" to one for EEVEE (``common.connect_engine_outputs``)."""
     ng = ensure_rt_lit_group(features, scene, lut_dir)
     nt = compat.ensure_node_tree(material)
     nodes = nt.nodes
@@ -272,11 +349,13 @@ def assign_rt_lit(material, features=None, scene=None, lut_dir=None):
         group = nodes.new("ShaderNodeGroup")
         group.name = group.label = RT_LIT_NODE_NAME
     group.node_tree = ng
+    group.width = max(group.width, 240.0)
     output = next((n for n in nodes if n.bl_idname == "ShaderNodeOutputMaterial" and n.is_active_output), None)
     if output is None:
         output = nodes.new("ShaderNodeOutputMaterial")
     group.location = (output.location.x - 300.0, output.location.y)
-    nt.links.new(group.outputs["Shader"], output.inputs["Surface"])
+    connect_engine_outputs(nt, group, output)
+    not_a_light(material)
     material[FEATURES_KEY] = (features or Features()).as_dict()
     return group
 

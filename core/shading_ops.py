@@ -214,8 +214,9 @@ def lut_sample(table, u, v, channel):
     """Channel of ``table`` (a ``core.ir.tables.Table``) at texture coordinates (u, v), bilinear with
     EXTEND (Image Texture node, Linear; the texel-centre rule of ``semantics.sample_bilinear``).
 
-    Traced, the bilinear filter is written out (``tables.bilinear_function``): four Closest fetches
-    and explicit weights, exact in Cycles and EEVEE alike.  In numpy the table must hold its data."""
+    Traced, it is a call of ``tables.bilinear_function``: four Closest fetches and explicit weights,
+    exact in Cycles and EEVEE alike, or under ``expr.table_filter("linear")`` one Linear read (Cycles'
+    trees).  In numpy the table must hold its data."""
     if is_expr(u, v):
         return bilinear_function(table)(u=u, v=v)["RGBA"[channel]]
     return semantics.sample_bilinear(table.require_data(), u, v)[..., channel]

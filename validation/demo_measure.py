@@ -54,7 +54,7 @@ def node_counts(scene_materials):
 
     from ..addon import materials
     from ..addon.common import FEATURES_KEY
-    from ..addon.node_emit import flat_tree_node_count, tree_node_counts
+    from ..addon.node_emit import tree_node_counts
     from ..core.materials import rt_lit
     from ..core.materials.rt_lit_interface import Features
 
@@ -67,7 +67,11 @@ def node_counts(scene_materials):
         features = Features.from_dict(ng[FEATURES_KEY])
         counts = tree_node_counts(ng)
         groups.update(counts)
-        per_features[features.label()] = {"group": ng.name, "blender_nodes_flat": flat_tree_node_count(ng),
+        engines = materials.engine_node_counts(ng)
+        per_features[features.label()] = {"group": ng.name,
+                                          # what Cycles compiles: its own tree (addon/materials.ENGINE_TREES)
+                                          "blender_nodes_flat": engines.get("Cycles", engines.get("All")),
+                                          "blender_nodes_flat_eevee": engines.get("EEVEE", engines.get("All")),
                                           "groups_nested": len(counts), "largest_group": max(counts.values()),
                                           **rt_lit.op_counts(features, kinds)}
     # all features on, for reference (not used by the demo)
@@ -198,11 +202,12 @@ def format_markdown(result, image_prefix=""):
     """demo.md; ``image_prefix``: the PNGs' folder relative to where the text goes ("demo/" in report.md)."""
     nc = result["node_counts"]
     lines = [f"Demo scene `{result['blend']}`: {result['cycles']['size'][0]}x{result['cycles']['size'][1]} px.", "",
-             "| RT Lit material (features) | IR ops before folding | after | Blender nodes, flattened | "
-             "nested groups | largest group |", "|---|---|---|---|---|---|"]
+             "| RT Lit material (features) | IR ops before folding | after | Blender nodes, flattened: Cycles tree | "
+             "EEVEE tree | nested groups | largest group |", "|---|---|---|---|---|---|---|"]
     for label, m in nc["materials"].items():
         lines.append(f"| {label} | {m['ir_ops_unfolded']} | {m['ir_ops_folded']} | {m.get('blender_nodes_flat', '-')} | "
-                     f"{m.get('groups_nested', '-')} | {m.get('largest_group', '-')} |")
+                     f"{m.get('blender_nodes_flat_eevee', '-')} | {m.get('groups_nested', '-')} | "
+                     f"{m.get('largest_group', '-')} |")
     lines += ["", "Nodes per group:", "", "| group | nodes |", "|---|---|"]
     lines += [f"| {name} | {count} |" for name, count in nc["groups"].items()]
     c = result["cycles"]

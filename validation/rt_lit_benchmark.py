@@ -221,11 +221,10 @@ def timed(features, configs, rounds):
 def ir_counts(features, lights=1):
     """Flattened IR operation counts (``flat_node_count``, as scripts/demo_report.py) of the RT Lit
     material for ``lights`` quad lights, without and with the World term (folded as built, and
-    unfolded), and the Blender nodes of the built group (flattened).  Builds the World scene."""
+    unfolded), and the Blender nodes of the built group's Cycles tree (flattened).  Builds the World scene."""
     import bpy
 
     from ..addon import materials, world_sync
-    from ..addon.node_emit import flat_tree_node_count
     from ..core.materials import rt_lit
     from ..core.materials.rt_lit_interface import rt_lit_group_name
 
@@ -236,7 +235,7 @@ def ir_counts(features, lights=1):
         env = world_sync.world_environment()[0] if world == WORLD_TERM else None
         ng = bpy.data.node_groups[rt_lit_group_name(features)]
         key = "world" if world == WORLD_TERM else "no_world"
-        counts[key] = {**rt_lit.op_counts(features, kinds, env), "blender_nodes_flat": flat_tree_node_count(ng)}
+        counts[key] = {**rt_lit.op_counts(features, kinds, env), "blender_nodes_flat": materials.engine_node_counts(ng)["Cycles"]}
     counts["world_term"] = {k: counts["world"][k] - counts["no_world"][k] for k in counts["world"]}
     return counts
 
@@ -370,8 +369,8 @@ def _markdown_node_counts(rows, total):
     lines = ["", "## Node counts of the World term", "",
              "One RT Lit material with 1 quad light: flattened IR operations (`core/ir/numpy_backend."
              "flat_node_count`, every function call expanded, as `scripts/demo_report.py`), folded (as built) "
-             "and without constant folding, and the Blender nodes of the built group with nested groups "
-             "flattened.", "",
+             "and without constant folding, and the Blender nodes of the built group's Cycles tree with nested "
+             "groups flattened (addon/materials.ENGINE_TREES).", "",
              "| features | IR ops, no world | with world | World term | unfolded: no world | with world | "
              "World term | Blender nodes: no world | with world | World term |",
              "|---|---|---|---|---|---|---|---|---|---|"]

@@ -48,6 +48,37 @@ def folding_enabled():
     return _FOLDING["enabled"]
 
 
+#: How traced code samples a table bilinearly (``shading_ops.lut_sample``): "fetch4" writes the filter
+#: out as four Closest fetches and their weights (exact in every engine; EEVEE's Linear filtering would
+#: pick mipmaps from screen-space derivatives), "linear" emits one ``lut`` read (an Image Texture node
+#: with Linear interpolation: Cycles' exact bilinear filter, docs/blender.md).
+TABLE_FILTERS = ("fetch4", "linear")
+_TABLE_FILTER = {"mode": "fetch4"}
+
+
+class table_filter:
+    """``with table_filter("linear"):`` traces table lookups as single Linear reads (for Cycles' trees).
+    Node functions keep one traced body per setting, as for ``folding``."""
+
+    def __init__(self, mode):
+        if mode not in TABLE_FILTERS:
+            raise ValueError(f"table filter {mode!r}: expected one of {TABLE_FILTERS}")
+        self.mode, self.previous = mode, None
+
+    def __enter__(self):
+        self.previous = _TABLE_FILTER["mode"]
+        _TABLE_FILTER["mode"] = self.mode
+        return self
+
+    def __exit__(self, *exc):
+        _TABLE_FILTER["mode"] = self.previous
+        return False
+
+
+def table_filter_mode():
+    return _TABLE_FILTER["mode"]
+
+
 class Graph:
     """Interns expressions; one graph per traced function."""
 

@@ -14,9 +14,23 @@ caller passes (``fn(tables=..., **inputs)``), which holds the data.
 """
 from __future__ import annotations
 
-from .expr import FLOAT, VECTOR, define, folding_enabled, graph_of, is_expr
+from .expr import FLOAT, VECTOR, define, folding_enabled, graph_of, is_expr, table_filter_mode, topological_order
 
 _KIND = {"float": FLOAT, "vector": VECTOR, "color": VECTOR}
+
+#: Name suffix of a function traced with ``expr.table_filter("linear")`` whose body (or a function it
+#: calls) reads a table with Linear filtering: its node group lives beside the four-fetch one.
+LINEAR_SUFFIX = " (Linear)"
+
+
+def reads_linear(function):
+    """Whether ``function`` (an ``expr.Function``) or one it calls has a ``lut`` (Linear) table read."""
+    for node in topological_order(list(function.outputs.values())):
+        if node.op == "lut":
+            return True
+        if node.op == "call" and node.graph.functions[node.attr("function")].name.endswith(LINEAR_SUFFIX):
+            return True
+    return False
 
 
 class NodeFunction:
@@ -28,7 +42,7 @@ class NodeFunction:
         self.input_sockets = dict(inputs)
         self.output_sockets = dict(outputs)
         self.trace_tables = tables
-        self._functions = {}        # folding on/off -> traced body
+        self._functions = {}        # (folding on/off, table filter) -> traced body
 
     @property
     def reads_tables(self):
@@ -40,9 +54,9 @@ class NodeFunction:
 
     @property
     def function(self):
-        """The traced body (``expr.Function``), built on first use (once with constant folding, once
-        without: ``expr.folding``)."""
-        folded = folding_enabled()
+        """The traced body (``expr.Function``), built on first use, once per setting of constant
+        folding (``expr.folding``) and of the table filter (``expr.table_filter``)."""
+        folded = (folding_enabled(), table_filter_mode())
         if folded not in self._functions:
             sockets = (self.input_sockets, self.output_sockets)
 
@@ -53,7 +67,11 @@ class NodeFunction:
                     raise ValueError(f"{self.name} did not return {sorted(missing)}")
                 return {k: out[k] for k in self.output_sockets}
 
-            self._functions[folded] = define(self.name, body, self.input_kinds, self.description, sockets)
+            function = define(self.name, body, self.input_kinds, self.description, sockets)
+            if folded[1] == "linear" and reads_linear(function):
+                # a different body under the same name would overwrite the other's node group
+                function.name = f"{self.name}{LINEAR_SUFFIX}"
+            self._functions[folded] = function
         return self._functions[folded]
 
     def _run(self, tables, args):

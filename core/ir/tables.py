@@ -7,7 +7,9 @@ own table for the world), so the same traced function serves every LUT folder, a
 exactly the tables it is given.
 
 ``bilinear_function(table)`` is how traced code samples a table with bilinear filtering: four Closest
-fetches and explicit weights, the rule of ``semantics.sample_bilinear`` written out in nodes.  EEVEE's
+fetches and explicit weights, the rule of ``semantics.sample_bilinear`` written out in nodes; traced
+under ``expr.table_filter("linear")`` (Cycles' trees) its body is one ``lut`` read, Image Texture with
+Linear interpolation, which Cycles evaluates with the same rule.  EEVEE's
 Linear filtering picks mipmaps from the screen-space derivatives of the coordinates, which for a table
 indexed by per-pixel values blurred lookups by up to 40% of the table's range (measured); Closest
 fetches are exact in both engines.
@@ -20,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .expr import FLOAT, graph_of, topological_order
+from .expr import FLOAT, graph_of, table_filter_mode, topological_order
 from .functions import NodeFunction
 from .interface import Socket
 from .semantics import TABLE_READS
@@ -115,6 +117,8 @@ def bilinear_function(table):
 
     def body(u, v):
         g = graph_of(u, v)
+        if table_filter_mode() == "linear":     # one Image Texture, Linear: the filter in hardware
+            return {name: g.read_table(ref, u, v, c, op="lut") for c, name in enumerate("RGBA")}
         u0, u1, fu = _axis(g, u, w)
         v0, v1, fv = _axis(g, v, h)
         # each tap is weighted and accumulated at once (one live tap at a time: Cycles' SVM stack

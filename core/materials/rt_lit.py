@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import lights
-from ..ir.expr import FLOAT, VECTOR, define, folding, folding_enabled
+from ..ir.expr import FLOAT, VECTOR, define, folding, folding_enabled, table_filter_mode
 from ..ir.interface import color
 from ..ir.numpy_backend import evaluate, flat_node_count
 from ..ir.tables import table_names
@@ -158,7 +158,7 @@ def _function_inputs(light_kinds, environment):
 def build_rt_lit(features=Features(), light_kinds=(), environment=None):
     """The whole RT Lit material traced for ``features``, the light kinds in order and the world's
     ``WorldEnvironment`` (None: no World term, nothing of it built).  Cached (per folding setting)."""
-    return _build(features, tuple(light_kinds), environment, folding_enabled())
+    return _build(features, tuple(light_kinds), environment, folding_enabled(), table_filter_mode())
 
 
 def op_counts(features, light_kinds=(), environment=None):
@@ -171,7 +171,7 @@ def op_counts(features, light_kinds=(), environment=None):
 
 
 @functools.lru_cache(maxsize=32)
-def _build(features, light_kinds, environment, folded):
+def _build(features, light_kinds, environment, folded, table_filter):
     kinds, sockets, per_light, world = _function_inputs(light_kinds, environment)
     part_names = [EMISSION_OUTPUT] + [light_output(i) for i in range(len(light_kinds))]
     if environment is not None:

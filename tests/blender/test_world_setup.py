@@ -409,7 +409,9 @@ def test_sync_world_switches_the_rt_lit_term_and_drops_stale_images(bpy_module, 
 
     def world_groups():
         ng = mat.node_tree.nodes["RT Lit"].node_tree
-        return {name for name in node_emit.tree_node_counts(ng) if name.startswith("RTL Shade World")}
+        # one per engine tree: the Cycles tree's carries the suffix " (Linear)"
+        return {name.removesuffix(" (Linear)") for name in node_emit.tree_node_counts(ng)
+                if name.startswith("RTL Shade World")}
 
     def env_images():
         return sorted(i.name for i in bpy.data.images if i.name.startswith("RTL_env_"))
