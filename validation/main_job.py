@@ -30,7 +30,10 @@ Steps (each prints what it does):
    sweep, the white furnace, node render vs numpy, bake times), report in <out>/validation_world/.
 11. Robustness sweep, quick (scripts/robustness_sweep.py --points 2000): NaN, Inf, negative and
    over-bound counts per technique family and backend.
-12. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
+12. Speed vs error, quick (scripts/benchmark_speed_error.py --quick): RT Lit in Cycles, in EEVEE, as GLSL and in
+   numpy against Cycles path tracing of the same BRDFs at 1 ... 256 spp, the equal-error speedup per family, into
+   <out>/benchmarks/speed_error/ (the full run is docs/benchmarks/speed_error.md).
+13. Report: <out>/report.md and <out>/report.json; exit 1 if an acceptance check fails.
 """
 from __future__ import annotations
 
@@ -62,7 +65,7 @@ LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main jo
 
 
 def step_luts(lut_dir, log=report.flush_log):
-    log(f"[1/12] LUTs in {lut_dir}")
+    log(f"[1/13] LUTs in {lut_dir}")
 
     def progress(group, done, total):
         if done == total or done % max(1, total // 4) == 0:
@@ -76,7 +79,7 @@ def step_luts(lut_dir, log=report.flush_log):
 
 
 def step_numpy_checks(lut_dir, log=report.flush_log):
-    log("[2/12] numpy energy checks")
+    log("[2/13] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
     cycles = validation.cycles_table_comparison(tables)
@@ -107,7 +110,7 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
 
 
 def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
-    log("[6/12] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
+    log("[6/13] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
     from . import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
@@ -116,7 +119,7 @@ def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
 
 
 def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
-    log("[7/12] lookdev scene (New Lookdev Scene) vs its path-traced twin, Cycles and EEVEE")
+    log("[7/13] lookdev scene (New Lookdev Scene) vs its path-traced twin, Cycles and EEVEE")
     from . import lookdev_twin
 
     result = lookdev_twin.run(out_dir / "lookdev", lut_dir=lut_dir, eevee=eevee, pictures_dir=REPO / "docs" / "images",
@@ -128,7 +131,7 @@ def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
 
 
 def step_lut_export(out_dir, lut_dir, log=report.flush_log):
-    log("[4/12] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
+    log("[4/13] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
     from ..core.export import luts as lut_export
 
     t0 = time.perf_counter()
@@ -158,7 +161,7 @@ def step_lut_export(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_robustness(out_dir, lut_dir, log=report.flush_log):
-    log("[11/12] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
+    log("[11/13] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
         "(scripts/robustness_sweep.py --points 2000)")
     from . import robustness
 
@@ -179,8 +182,26 @@ def step_robustness(out_dir, lut_dir, log=report.flush_log):
             "passed": result["failures"] == 0, "summary_markdown": text}
 
 
+def step_speed_error(out_dir, lut_dir, eevee=True, log=report.flush_log):
+    log("[12/13] speed vs error, quick: RT Lit's backends against path tracing at equal error "
+        "(scripts/benchmark_speed_error.py --quick)")
+    from . import speed_error
+
+    folder = out_dir / "benchmarks" / "speed_error"
+    cache = out_dir / "validation_world" / "env_cache"           # the world validation's bakes, when there
+    result = speed_error.run(folder, lut_dir=lut_dir, quick=True, log=lambda line: log("      " + line), eevee=eevee,
+                             cache_dir=cache if cache.is_dir() else None,
+                             command="python scripts/benchmark_speed_error.py --quick (main job)")
+    text = (result["summary_markdown"] + "\n\nPath tracing's error decay (rel RMS ~ spp^-k), median k per family: "
+            + ", ".join(f"{f} {e['median']:.2f}" for f, e in result["exponents"].items())
+            + f".  Method, times and per-sphere rows: `{folder / 'speed_error.md'}`; the full run: "
+            "docs/benchmarks/speed_error.md (`python scripts/benchmark_speed_error.py`).")
+    return {"passed": bool(result["passed"]), "families": result["families"], "exponents": result["exponents"],
+            "seconds": result["seconds"], "summary_markdown": text}
+
+
 def step_realtime_benchmark(out_dir, log=report.flush_log):
-    log("[8/12] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
+    log("[8/13] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
     from . import glsl_runner, realtime_benchmark
 
     glsl_runner.disable_shader_cache()
@@ -207,7 +228,7 @@ def _run_suite(module, folder, lut_dir, log):
 
 
 def step_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[9/12] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
+    log("[9/13] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
     from . import suite
 
     result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
@@ -216,7 +237,7 @@ def step_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_world_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[10/12] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
+    log("[10/13] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
     from . import world_suite
 
     result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
@@ -226,7 +247,7 @@ def step_world_validation(out_dir, lut_dir, log=report.flush_log):
 
 
 def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
-    log("[5/12] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
+    log("[5/13] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
     from . import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
@@ -237,7 +258,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
 
 
 def step_ltc(lut_dir, log=report.flush_log):
-    log("[3/12] LTC area lights: random quads and disks vs brute force")
+    log("[3/13] LTC area lights: random quads and disks vs brute force")
     from . import ltc_benchmark as benchmark_ltc
 
     t0 = time.perf_counter()
@@ -317,6 +338,9 @@ def write_report(job, out_dir):
     robust = job.get("robustness")
     lines += ["## Robustness (quick sweep)", ""]
     lines += [robust["summary_markdown"], ""] if robust else ["Skipped.", ""]
+    speed = job.get("speed_error")
+    lines += ["## Speed vs error (quick): equal-error speedup over path tracing", ""]
+    lines += [speed["summary_markdown"], ""] if speed else ["Skipped (--skip-render).", ""]
     lines += [f"Overall: **{'PASS' if job['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
@@ -338,7 +362,7 @@ def _passed(job):
     return bool(job["luts"]["passed"] and job["numpy_checks"]["passed"] and job["ltc"]["passed"]
                 and all(job.get(k) is None or job[k].get("passed", False)
                         for k in ("lut_export", "render", "demo", "lookdev_twin", "realtime_benchmark", "validation",
-                                  "world_validation", "robustness")))
+                                  "world_validation", "robustness", "speed_error")))
 
 
 def run(args, log=report.flush_log):
@@ -355,6 +379,7 @@ def run(args, log=report.flush_log):
     job["ltc"] = step_ltc(args.lut_dir, log)
     job["lut_export"] = step_lut_export(args.out, args.lut_dir, log)
     job["render"] = job["demo"] = job["lookdev_twin"] = job["validation"] = job["world_validation"] = None
+    job["speed_error"] = None
     if not args.skip_render:
         job["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
         job["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
@@ -364,9 +389,11 @@ def run(args, log=report.flush_log):
         job["validation"] = step_validation(args.out, args.lut_dir, log)
         job["world_validation"] = step_world_validation(args.out, args.lut_dir, log)
     job["robustness"] = step_robustness(args.out, args.lut_dir, log)
+    if not args.skip_render:
+        job["speed_error"] = step_speed_error(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
     job["passed"] = _passed(job)
     job["seconds"] = time.perf_counter() - t0
-    log("[12/12] report")
+    log("[13/13] report")
     write_report(job, args.out)
     log((args.out / "report.md").read_text())
     log(f"report written to {args.out / 'report.md'} and report.json")

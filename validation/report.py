@@ -94,6 +94,8 @@ figure{display:inline-block;margin:0 8px 8px 0}figcaption{font-size:12px}
 
 
 def write_html(path, result):
+    from .suite_cases import CYCLES_ERROR_EXPONENTS
+
     s = result["settings"]
     out = [f"<!doctype html><html><head><meta charset='utf-8'><title>RT Lookdev validation</title>"
            f"<style>{_CSS}</style></head><body>",
@@ -109,7 +111,9 @@ def write_html(path, result):
            f"max (the gated figures); the same statistics with the floor at {s['floor_wide']:g} x max are in the "
            "JSON/CSV ('wide'). Noise: |c1 - c2| / 2 per value, the Monte Carlo error of c, reported with the "
            "same statistics; 'spp to match' = the Cycles samples whose noise equals the node render's own RMS "
-           "error (noise scaling 1/sqrt(spp); '&ge;' when the node error is below this comparison's noise).</p>"]
+           "error (noise scaling as spp^-k, k per family "
+           f"{', '.join(f'{f} {k:g}' for f, k in CYCLES_ERROR_EXPONENTS.items())}, measured by the speed-vs-error benchmark, "
+           "docs/benchmarks/speed_error.md; '&ge;' when the node error is below this comparison's noise).</p>"]
     # checks
     out.append("<h2>Acceptance checks</h2><table><tr><th>check</th><th>measured</th><th>threshold</th><th></th></tr>")
     for c in result["checks"]:

@@ -707,12 +707,38 @@ def ab_metrics(a, b, mask, near_zero=1e-2, conditioning=None, tol=1e-4, atol=1e-
     return out
 
 
-def truth_metrics(a, c, mask, floor_frac, c_pair=None, samples_total=None, qerr=None):
+#: Cycles' path-tracing error falls as spp^-k in these scenes (spheres seen by camera rays only, direct light),
+#: not as 1/sqrt(spp) (k = 0.5): its stratified, scrambled sample sequences integrate the smooth direct-lighting
+#: integrand faster.  Measured by validation/speed_error.py (docs/benchmarks/speed_error.md, "Path tracing's
+#: error decay": relative RMS error of 1 ... 4096 spp ladders against 4096 spp x 2 references, median per family
+#: under quad and disk lights; full run 2026-12-02): diffuse (Lambert) 1.09 (0.91-1.13, 5 spheres), glossy (GGX
+#: r <= 0.3) 0.77 (0.74-0.86, 5), rough (GGX and Multiscatter GGX r > 0.3) 0.99 (0.81-1.07, 10).
+CYCLES_ERROR_EXPONENTS = {"diffuse": 1.09, "glossy": 0.77, "rough": 0.99}
+#: A variant without a family of its own (the suite's other closures) takes the pooled median.
+CYCLES_ERROR_EXPONENT = 0.99
+#: The same under a studio HDRI (the world validation): 0.66 median (0.62-0.70, forest and sunrise, 8 spheres).
+CYCLES_WORLD_ERROR_EXPONENT = 0.66
+#: Largest roughness of the "glossy" family (as validation/speed_error.py).
+GLOSSY_MAX_ROUGHNESS = 0.3
+
+
+def cycles_error_exponent(variant):
+    """k of Cycles' error ~ spp^-k for a suite variant (``CYCLES_ERROR_EXPONENTS`` by its family)."""
+    if variant.technique == "lambert":
+        return CYCLES_ERROR_EXPONENTS["diffuse"]
+    if variant.technique in ("ggx", "turquin", "fdez_aguera", "dielectric", "metal"):
+        return CYCLES_ERROR_EXPONENTS["glossy" if variant.roughness <= GLOSSY_MAX_ROUGHNESS else "rough"]
+    return CYCLES_ERROR_EXPONENT
+
+
+def truth_metrics(a, c, mask, floor_frac, c_pair=None, samples_total=None, qerr=None,
+                  error_exponent=CYCLES_ERROR_EXPONENT):
     """(a) vs (c) over the values (pixels x channels) of ``mask`` where c > floor_frac * max(c).
 
     ``c_pair``: the two seed images (c is their mean) for the Monte Carlo noise: per value
     sigma_c = |c1 - c2| / 2, an unbiased one-sample estimate of the noise of c (so the
     "noise_*" figures are what the error statistics would be if the node render were exact).
+    ``error_exponent``: k of Cycles' error ~ spp^-k, for ``cycles_spp_to_match``.
     """
     av, cv = a[mask].astype(np.float64).ravel(), c[mask].astype(np.float64).ravel()
     ok = np.isfinite(cv)
@@ -740,11 +766,13 @@ def truth_metrics(a, c, mask, floor_frac, c_pair=None, samples_total=None, qerr=
         own = math.sqrt(max(out["rms_rel"] ** 2 - out["noise_rms_rel"] ** 2, 0.0))
         out["node_rms_rel_excess"] = own
         if samples_total:
-            # Cycles noise ~ 1/sqrt(spp): samples for Cycles' own RMS relative noise to equal the node
-            # render's error.  Below the noise floor of this comparison the figure is a lower bound.
+            # Cycles noise ~ spp^-k (``error_exponent``, measured: CYCLES_ERROR_EXPONENT): samples for Cycles' own
+            # RMS relative noise to equal the node render's error (the two seeds' samples counted as one render's).
+            # Below the noise floor of this comparison the figure is a lower bound.
             resolved = own > 0.5 * out["noise_rms_rel"]
             eff = own if resolved else 0.5 * out["noise_rms_rel"]
-            out["cycles_spp_to_match"] = float(samples_total * (out["noise_rms_rel"] / eff) ** 2) if eff > 0 else None
+            out["cycles_spp_to_match"] = (float(samples_total * (out["noise_rms_rel"] / eff) ** (1.0 / error_exponent))
+                                          if eff > 0 else None)
             out["cycles_spp_to_match_is_lower_bound"] = not resolved
     if qerr is not None:
         qv = qerr[mask].astype(np.float64).reshape(-1)[sel] / cv[sel]

@@ -413,8 +413,10 @@ def _truth_comparison(spec, i, v, ws, nr, truth, mu_img, samples_total, args):
     frac = vw.max_fraction(c_cell, m, args.floor)
     frac_w = vw.max_fraction(c_cell, m, args.floor_wide)
     metrics = {"cell_normal_max_diff": ndiff,
-               "truth_metrics": suite.truth_metrics(a_cell, c_cell, m, frac, pair, samples_total),
-               "truth_metrics_wide": suite.truth_metrics(a_cell, c_cell, m, frac_w, pair, samples_total)}
+               "truth_metrics": suite.truth_metrics(a_cell, c_cell, m, frac, pair, samples_total,
+                                                    error_exponent=suite.CYCLES_WORLD_ERROR_EXPONENT),
+               "truth_metrics_wide": suite.truth_metrics(a_cell, c_cell, m, frac_w, pair, samples_total,
+                                                         error_exponent=suite.CYCLES_WORLD_ERROR_EXPONENT)}
     rel, noise = _rel_values(a_cell, c_cell, m, frac, pair)
     rel_w, _ = _rel_values(a_cell, c_cell, m, frac_w)
     rel_f = _front_rel_values(a_cell, c_cell, m, ws.nb.cell(mu_img, i), frac)

@@ -31,6 +31,7 @@ RUN_BY = {
     "scripts/validate_world.py": MAIN_JOB,
     "scripts/export_luts.py": MAIN_JOB,
     "scripts/benchmark_realtime.py": MAIN_JOB,
+    "scripts/benchmark_speed_error.py": MAIN_JOB,
     "scripts/export_shader.py": "tests/glsl/test_shader_compile.py",
     "scripts/build_extension.py": "tests/blender/test_extension_install.py",
     "scripts/benchmark_luts.py": "here",

@@ -11,20 +11,21 @@ def test_report_is_written_from_the_steps(tmp_path, monkeypatch):
            "luts": main_job.step_luts(catalog.default_lut_dir(), quiet),
            "numpy_checks": main_job.step_numpy_checks(catalog.default_lut_dir(), quiet),
            "ltc": main_job.step_ltc(catalog.default_lut_dir(), quiet),
-           "render": None, "demo": None, "lookdev_twin": None, "validation": None, "world_validation": None}
+           "render": None, "demo": None, "lookdev_twin": None, "validation": None, "world_validation": None,
+           "speed_error": None}
     job["passed"] = main_job._passed(job)
     main_job.write_report(job, tmp_path / "skipped")
     text = (tmp_path / "skipped" / "report.md").read_text()
-    assert text.count("Skipped (--skip-render).") == 5 and "## LTC area lights" in text
+    assert text.count("Skipped (--skip-render).") == 6 and "## LTC area lights" in text
     assert (tmp_path / "skipped" / "report.json").stat().st_size > 0
     job["render"] = {"settings": {"resolution_per_sphere": 8, "samples": 4, "seeds": [0, 1], "z_max": 5.0,
                                   "sys_tol": 5e-4, "ms_tol": 0.005}, "summary_markdown": "RENDER TABLE",
                      "passed": True}
     for step in ("lut_export", "demo", "lookdev_twin", "realtime_benchmark", "validation", "world_validation",
-                 "robustness"):
+                 "robustness", "speed_error"):
         job[step] = {"summary_markdown": f"{step.upper()} TABLE", "passed": True}
     main_job.write_report(job, tmp_path / "full")
     text = (tmp_path / "full" / "report.md").read_text()
     assert all(f"{s} TABLE" in text for s in ("RENDER", "LUT_EXPORT", "DEMO", "LOOKDEV_TWIN", "REALTIME_BENCHMARK", "VALIDATION",
-                                              "WORLD_VALIDATION", "ROBUSTNESS"))
+                                              "WORLD_VALIDATION", "ROBUSTNESS", "SPEED_ERROR"))
     assert "Skipped" not in text
