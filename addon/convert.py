@@ -66,6 +66,7 @@ SPECULAR_LABELS = {
     "turquin": ("Turquin", "Turquin 2019 energy compensation (scales the GGX lobe by 1 / E)"),
     "fdez_aguera": ("Fdez-Agüera", "Fdez-Agüera 2019 multiple-scattering approximation"),
     "kulla_conty": ("Kulla-Conty", "Kulla & Conty 2017 multiple-scattering lobe"),
+    "none": ("None", "No specular lobe: diffuse (and cloth, sheen) only"),
 }
 DIFFUSE_LABELS = {
     "lambert": ("Lambert", "Lambertian diffuse"),

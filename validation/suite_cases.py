@@ -49,7 +49,7 @@ BLACK = (0.0, 0.0, 0.0)
 
 #: Technique -> (RT Lit features, truth kind, short description).
 TECHNIQUES = {
-    "lambert": (Features("single", "lambert", cloth=True), "cycles", "Lambert diffuse vs Cycles Diffuse BSDF"),
+    "lambert": (Features("none", "lambert"), "cycles", "Lambert diffuse vs Cycles Diffuse BSDF"),
     "ggx": (Features("single", "lambert"), "cycles", "single-scattering GGX, F0 = 1, vs Cycles Glossy GGX"),
     "turquin": (Features("turquin", "lambert"), "cycles",
                 "Turquin multiscattering GGX, F0 = 1, vs Cycles Glossy Multiscatter GGX"),
@@ -59,10 +59,10 @@ TECHNIQUES = {
                    "GGX (Schlick F0 0.04) + Lambert vs Cycles Metallic BSDF (GGX, F82 white) + Diffuse BSDF"),
     "metal": (Features("single", "lambert"), "cycles",
               "GGX with coloured Schlick F0 vs Cycles Metallic BSDF (GGX, F82 white tint)"),
-    "cod": (Features("single", "cod", cloth=True), "brute", "CoD WWII multiscattering diffuse vs its integral"),
-    "wrapped": (Features("single", "wrapped", cloth=True), "brute", "wrapped diffuse vs its integral"),
-    "cloth": (Features("single", "lambert", cloth=True), "brute", "Ashikhmin cloth vs its integral"),
-    "sheen": (Features("single", "lambert", sheen=True, cloth=True), "brute", "Disney sheen vs its integral"),
+    "cod": (Features("none", "cod"), "brute", "CoD WWII multiscattering diffuse vs its integral"),
+    "wrapped": (Features("none", "wrapped"), "brute", "wrapped diffuse vs its integral"),
+    "cloth": (Features("none", "lambert", cloth=True), "brute", "Ashikhmin cloth vs its integral"),
+    "sheen": (Features("none", "lambert", sheen=True), "brute", "Disney sheen vs its integral"),
     "kulla_conty": (Features("kulla_conty", "lambert"), "brute",
                     "Kulla-Conty GGX with coloured F0 vs the integral of f_ss + F_ms f_ms"),
     "turquin_color": (Features("turquin", "lambert"), "brute",
@@ -71,11 +71,13 @@ TECHNIQUES = {
 
 
 def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
-    """RT Lit input values of a variant (the inputs not given keep RT_LIT_INPUTS' defaults)."""
+    """RT Lit input values of a variant (the inputs not given keep RT_LIT_INPUTS' defaults).  The diffuse,
+    cloth and sheen techniques are built without specular (``TECHNIQUES``: specular "none"); Metallic 1
+    removes the diffuse where only cloth or sheen is measured."""
     m = {"Roughness": float(roughness), "Base Color": WHITE, "Metallic": 0.0, "Cloth Weight": 0.0,
          "Cloth Color": BLACK, "Sheen Weight": 0.0, "Wrap": 0.0}
     if technique in ("lambert", "cod", "wrapped"):
-        m.update({"Base Color": color or WHITE, "Cloth Weight": 1.0, "Cloth Color": BLACK})
+        m.update({"Base Color": color or WHITE})
         if technique == "wrapped":
             m["Wrap"] = float(wrap)
     elif technique in ("ggx", "turquin", "fdez_aguera"):
@@ -87,8 +89,7 @@ def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
     elif technique == "cloth":
         m.update({"Metallic": 1.0, "Cloth Weight": 1.0, "Cloth Color": color or WHITE})
     elif technique == "sheen":
-        m.update({"Metallic": 1.0, "Cloth Weight": 1.0, "Cloth Color": BLACK, "Sheen Weight": 1.0,
-                  "Sheen Tint": color or WHITE})
+        m.update({"Metallic": 1.0, "Sheen Weight": 1.0, "Sheen Tint": color or WHITE})
     else:
         raise ValueError(f"unknown technique {technique!r}")
     return m

@@ -52,8 +52,8 @@ FURNACE_ROUGHNESS = (0.0, 0.25, 0.5, 0.75, 1.0)
 
 #: technique -> (RT Lit features, Cycles closure of the truth or None (brute force), description).
 TECHNIQUES = {
-    "lambert": (Features("single", "lambert", cloth=True), "DIFFUSE", "Lambert (SH irradiance) vs Cycles Diffuse BSDF"),
-    "cod": (Features("single", "cod", cloth=True), None,
+    "lambert": (Features("none", "lambert"), "DIFFUSE", "Lambert (SH irradiance) vs Cycles Diffuse BSDF"),
+    "cod": (Features("none", "cod"), None,
             "CoD WWII diffuse (the talk's SH-LTC lobe) vs the brute-force integral of its BRDF"),
     "ggx": (Features("single", "lambert"), "GGX", "single-scattering split sum, F0 = 1, vs Cycles Glossy GGX"),
     "turquin": (Features("turquin", "lambert"), "MULTI_GGX",
@@ -70,8 +70,8 @@ MULTISCATTER = ("turquin", "fdez_aguera", "fdez_aguera_radiance", "kulla_conty")
 
 
 def technique_material(technique, roughness):
-    """RT Lit input values (validation_suite.technique_material): white Lambert / CoD (specular off by
-    a black cloth of weight 1), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
+    """RT Lit input values (validation_suite.technique_material): white Lambert / CoD (built without
+    specular: ``TECHNIQUES``), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
     from . import suite_cases as suite
 
     base = technique if technique in ("lambert", "cod") else "ggx"

@@ -23,7 +23,7 @@ MEASURED = {
 
 # Rough cost order of the switches, for feature sets that were not measured: a measured set at least as
 # costly in every switch bounds the capacity from below.
-_SPECULAR_COST = {"single": 0, "turquin": 1, "fdez_aguera": 1, "kulla_conty": 2}
+_SPECULAR_COST = {"none": 0, "single": 0, "turquin": 1, "fdez_aguera": 1, "kulla_conty": 2}
 _DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1}
 
 

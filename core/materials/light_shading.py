@@ -23,6 +23,8 @@ def combine_lobes(features, surface, lobe_values, light_color, area=False):
     """Radiance towards the viewer from one light: the enabled lobes weighted by the material's
     colours, times the light's colour (radiance or irradiance, per light kind; ``area``: an area
     light's, whose lobes are integrals over the light)."""
+    if features.specular == "none":
+        return _without_specular(features, surface, lobe_values, light_color)
     f0 = surface["F0"]
     spec = op.scale(f0, lobe_values["Scale"]) + op.splat(lobe_values["Bias"])
     if features.specular == "turquin":
@@ -53,9 +55,20 @@ def combine_lobes(features, surface, lobe_values, light_color, area=False):
     return op.vmul(light_color, total)
 
 
+def _without_specular(features, surface, lobe_values, light_color):
+    """``combine_lobes`` with the specular switched off: the cloth lobe still blends in by Cloth Weight
+    (over no specular), the diffuse and sheen add."""
+    total = op.scale(surface["Albedo"], lobe_values["Diffuse"])
+    if features.cloth:
+        total = total + op.scale(op.scale(surface["Cloth Color"], lobe_values["Cloth"]), surface["Cloth Weight"])
+    if features.sheen:
+        total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
+    return op.vmul(light_color, total)
+
+
 def lobe_keys(features):
     """The lobes ``features`` enables, in evaluation order."""
-    keys = ["ggx", features.diffuse]
+    keys = ([] if features.specular == "none" else ["ggx"]) + [features.diffuse]
     if features.specular == "kulla_conty":
         keys.append("kulla_conty")
     if features.cloth:

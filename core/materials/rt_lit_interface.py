@@ -17,7 +17,9 @@ from dataclasses import asdict, dataclass, fields
 
 from ..ir.interface import Socket, color, factor, scalar, vector
 
-SPECULAR_MODELS = ("single", "turquin", "fdez_aguera", "kulla_conty")
+#: "none" switches the specular lobe off (no GGX lobe, tables or world specular term in the tree): a
+#: diffuse-only material, e.g. for checking the diffuse models alone.
+SPECULAR_MODELS = ("single", "turquin", "fdez_aguera", "kulla_conty", "none")
 DIFFUSE_MODELS = ("lambert", "cod", "wrapped")
 #: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
 #: the prefiltered radiance (the talk's approximation); core/materials/world.py.
@@ -140,7 +142,7 @@ class Features:
         return cls(**{k: v for k, v in dict(data).items() if k in names})
 
     def label(self):
-        parts = [self.specular.replace("_", "-"), self.diffuse]
+        parts = ["no specular" if self.specular == "none" else self.specular.replace("_", "-"), self.diffuse]
         if self.specular == "fdez_aguera" and self.environment_ms != "irradiance":
             parts[0] += f" ({self.environment_ms})"
         parts += [p for p, on in (("sheen", self.sheen), ("cloth", self.cloth)) if on]

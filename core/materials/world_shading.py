@@ -348,27 +348,35 @@ def world_radiance(tables, features, env, surface, params):
         lobe = SH_LTC_COD(tables, N=n, V=v, Roughness=r)
         diffuse = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
 
-    # specular, per F0, then mixed
+    spec = _world_specular(tables, features, env, surface, n, v, r, irradiance)
+    if features.cloth:
+        lobe = SH_LTC_CLOTH(tables, N=n, V=v, Roughness=r)
+        cloth = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
+        w = surface["Cloth Weight"]
+        cloth = op.scale(op.vmul(surface["Cloth Color"], cloth), w)
+        spec = cloth if spec is None else op.scale(spec, 1.0 - w) + cloth
+    total = op.vmul(surface["Albedo"], diffuse)
+    if spec is not None:
+        total = spec + total
+    if features.sheen:
+        lobe = SH_LTC_SHEEN(tables, N=n, V=v)
+        sheen = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
+        total = total + op.vmul(surface["Sheen Color"], sheen)
+    return op.scale(total, params["Strength"])
+
+
+def _world_specular(tables, features, env, surface, n, v, r, irradiance):
+    """The world's specular term, per F0 and mixed by Metallic (None with the specular switched off)."""
+    if features.specular == "none":
+        return None
     scale_a, bias_b = tables.split_sum(op.saturate(op.dot(n, v)), r)
     prefiltered = prefiltered_function(env)(Direction=dominant_direction(n, v, r), Roughness=r)["Radiance"]
     spec_fn = specular_function(features.specular, getattr(features, "environment_ms", "irradiance"))
     extra = {"Roughness": r} if features.specular == "kulla_conty" else {}
     common = dict(Scale=scale_a, Bias=bias_b, Prefiltered=prefiltered, Irradiance=irradiance, **extra)
     m = surface["Metallic"]
-    spec = op.scale(spec_fn(tables, F0=surface["Dielectric F0"], **common)["Specular"], 1.0 - m) \
+    return op.scale(spec_fn(tables, F0=surface["Dielectric F0"], **common)["Specular"], 1.0 - m) \
         + op.scale(spec_fn(tables, F0=surface["Metal F0"], **common)["Specular"], m)
-
-    if features.cloth:
-        lobe = SH_LTC_CLOTH(tables, N=n, V=v, Roughness=r)
-        cloth = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
-        w = surface["Cloth Weight"]
-        spec = op.scale(spec, 1.0 - w) + op.scale(op.vmul(surface["Cloth Color"], cloth), w)
-    total = spec + op.vmul(surface["Albedo"], diffuse)
-    if features.sheen:
-        lobe = SH_LTC_SHEEN(tables, N=n, V=v)
-        sheen = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
-        total = total + op.vmul(surface["Sheen Color"], sheen)
-    return op.scale(total, params["Strength"])
 
 
 @functools.lru_cache(maxsize=16)

@@ -129,3 +129,19 @@ def test_cycles_and_eevee_trees_render_the_same_material(empty_scene, lut_dir):
     stats = engines.compare(*(renders[e][0] for e in engines.ENGINES))
     print(stats)
     assert stats["count"] > 500 and stats["median"] < EEVEE_MEDIAN_TOL and stats["p99"] < EEVEE_P99_TOL, stats
+
+
+def test_a_material_without_specular_renders_like_numpy(empty_scene, lut_dir, tables):
+    """Features(specular="none") through the whole bpy path: the group builds, Cycles renders it as numpy."""
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+    from rt_lookdev.validation import engines, lit_scene
+
+    scene = lit_scene.build([("diffuse only", Features("none", "cod", sheen=True))], kinds=("quad", "point"),
+                            lut_dir=lut_dir)
+    passes = engines.render_cycles_passes(scene, (scene.render.resolution_x, scene.render.resolution_y))
+    want, hit = lit_scene.numpy_radiance(scene, passes, tables)
+    got = passes["Combined"]
+    big = np.abs(want) >= 1e-2
+    assert hit.sum() > 500 and want.max() > 0.1
+    assert np.max(np.abs(got - want)[big] / np.abs(want)[big]) <= 1e-4
+    assert np.max(np.abs(got - want)[~big]) <= 1e-6

@@ -82,7 +82,8 @@ def test_shade_groups_match_numpy(empty_scene, tables, kind):
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
     vals = shade_inputs(kind)
-    for features in (Features("kulla_conty", "wrapped", sheen=True, cloth=True), Features("turquin", "cod")):
+    for features in (Features("kulla_conty", "wrapped", sheen=True, cloth=True), Features("turquin", "cod"),
+                     Features("none", "cod", sheen=True, cloth=True)):
         fn = light_shading.shade_function(kind, features)
         check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, tables)
 

@@ -95,6 +95,7 @@ ALL_FEATURES = [Features(s, d, sheen, cloth, form)
                                                  ("turquin", "cod", False, False, "irradiance"),
                                                  ("fdez_aguera", "wrapped", True, False, "irradiance"),
                                                  ("fdez_aguera", "cod", False, True, "radiance"),
+                                                 ("none", "wrapped", True, True, "irradiance"),
                                                  ("kulla_conty", "cod", True, True, "irradiance"))]
 
 
