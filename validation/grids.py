@@ -205,6 +205,10 @@ def shade_inputs(kind, seed=9, size=SIZE):
                  "Sheen Color": rng.random(shape + (3,)), "Cloth Color": rng.random(shape + (3,)),
                  "Cloth Weight": rng.random(shape), "Radiance": rng.random(shape + (3,)) * 10,
                  "Irradiance": rng.random(shape + (3,)) * 10, "L": unit_vectors(rng, shape)})
+    # the split specular models' inputs (light_shading.SPLIT_F0_MODELS), drawn after the others so they keep
+    # their values
+    vals.update({"Dielectric F0": rng.random(shape + (3,)) * 0.1, "Metal F0": rng.random(shape + (3,)),
+                 "Metallic": rng.random(shape)})
     return {k: np.asarray(v, np.float32) for k, v in vals.items()}
 
 

@@ -19,21 +19,23 @@ from . import lobes
 from .rt_lit_interface import GEOMETRY_INPUTS, SURFACE_OUTPUTS
 
 
-def combine_lobes(features, surface, lobe_values, light_color, area=False):
-    """Radiance towards the viewer from one light: the enabled lobes weighted by the material's
-    colours, times the light's colour (radiance or irradiance, per light kind; ``area``: an area
-    light's, whose lobes are integrals over the light)."""
-    if features.specular == "none":
-        return _without_specular(features, surface, lobe_values, light_color)
-    f0 = surface["F0"]
+#: Specular models whose compensation is non-linear in F0: a partly metallic surface is shaded once with
+#: the dielectric F0 and once with the metal's, then mixed by Metallic (as the World term does).  The single-
+#: scattering lobe, F0 * Scale + Bias, is linear in F0, so its mixed F0 gives the same value at less cost.
+SPLIT_F0_MODELS = ("turquin", "fdez_aguera", "kulla_conty")
+
+
+def specular_color(features, f0, lobe_values, area=False):
+    """The specular lobe's colour for one F0 (3-vector): F0 * Scale + Bias, times the specular model's
+    multiple-scattering compensation (``area``: the lobes are integrals over an area light)."""
     spec = op.scale(f0, lobe_values["Scale"]) + op.splat(lobe_values["Bias"])
     if features.specular == "turquin":
         # Turquin 2019, eq. 16 (the talk): f_ss (1 + F0 (1 - E)/E)
-        spec = op.vmul(spec, op.per_channel(multiscatter.turquin_compensation, f0, lobe_values["E"]))
-    elif features.specular == "fdez_aguera":
+        return op.vmul(spec, op.per_channel(multiscatter.turquin_compensation, f0, lobe_values["E"]))
+    if features.specular == "fdez_aguera":
         # The talk's approximation to Fdez-Aguera 2019: f_ss (1 + F_avg (1 - E)/(1 - F_avg (1 - E)))
-        spec = op.vmul(spec, op.per_channel(multiscatter.fdez_aguera_area_scale, f0, lobe_values["E"]))
-    elif features.specular == "kulla_conty":
+        return op.vmul(spec, op.per_channel(multiscatter.fdez_aguera_area_scale, f0, lobe_values["E"]))
+    if features.specular == "kulla_conty":
         # Kulla & Conty 2017: + F_ms(F_avg) f_ms
         om_avg = lobe_values["One Minus E Avg"]
         f_ms = op.per_channel(lambda c: multiscatter.kulla_conty_fresnel_factor(fresnel_average(c), om_avg), f0)
@@ -44,7 +46,28 @@ def combine_lobes(features, surface, lobe_values, light_color, area=False):
             # near-mirrors (E_ltc ~ 0.99, E_table ~ 0.61 at mu_v -> 0, r -> 0), where their sum reached 1.39
             # of the light (docs/robustness.md).  The lobe is bounded by what the first leaves, 1 - E_ltc.
             lobe = op.minimum(lobe, op.maximum(1.0 - lobe_values["E"], 0.0))
-        spec = spec + op.scale(f_ms, lobe)
+        return spec + op.scale(f_ms, lobe)
+    return spec
+
+
+def mixed_specular_color(features, surface, lobe_values, area=False):
+    """The specular colour of a surface that is Metallic parts metal: the dielectric's and the metal's, each
+    compensated with its own F0, mixed by Metallic (``SPLIT_F0_MODELS``), or the mixed F0's when that is
+    exact (single scattering)."""
+    if features.specular not in SPLIT_F0_MODELS:
+        return specular_color(features, surface["F0"], lobe_values, area)
+    m = surface["Metallic"]
+    return (op.scale(specular_color(features, surface["Dielectric F0"], lobe_values, area), 1.0 - m)
+            + op.scale(specular_color(features, surface["Metal F0"], lobe_values, area), m))
+
+
+def combine_lobes(features, surface, lobe_values, light_color, area=False):
+    """Radiance towards the viewer from one light: the enabled lobes weighted by the material's
+    colours, times the light's colour (radiance or irradiance, per light kind; ``area``: an area
+    light's, whose lobes are integrals over the light)."""
+    if features.specular == "none":
+        return _without_specular(features, surface, lobe_values, light_color)
+    spec = mixed_specular_color(features, surface, lobe_values, area)
     if features.cloth:
         cloth = op.scale(surface["Cloth Color"], lobe_values["Cloth"])
         w = surface["Cloth Weight"]
@@ -78,8 +101,20 @@ def lobe_keys(features):
     return keys
 
 
-#: The surface terms a light's shading reads.
+#: The surface terms a light's shading reads (``shade_surface``: those of one feature set).
 SHADE_SURFACE = ("N", "V", "Roughness", "F0", "Albedo", "Wrap", "Sheen Color", "Cloth Weight", "Cloth Color")
+#: What the split specular models read instead of the mixed F0.
+SPLIT_F0_SURFACE = ("Dielectric F0", "Metal F0", "Metallic")
+
+
+def shade_surface(features):
+    """The surface terms one light's shading reads with ``features``: the mixed F0, or the dielectric and
+    metal F0 and Metallic for the models that shade them apart (``SPLIT_F0_MODELS``), no F0 without specular."""
+    if features.specular == "none":
+        return tuple(k for k in SHADE_SURFACE if k != "F0")
+    if features.specular not in SPLIT_F0_MODELS:
+        return SHADE_SURFACE
+    return tuple(k for k in SHADE_SURFACE if k != "F0") + SPLIT_F0_SURFACE
 
 
 def light_color_name(kind):
@@ -103,13 +138,14 @@ def shade_function(kind, features):
             values.update(fn(tables, **_arguments(fn, kw)))
         return {"Radiance": combine_lobes(features, kw, values, kw[color_name], kind in lobes.AREA_KINDS)}
 
-    inputs = {k: SURFACE_OUTPUTS[k] for k in SHADE_SURFACE}
+    surface_terms = shade_surface(features)
+    inputs = {k: SURFACE_OUTPUTS[k] for k in surface_terms}
     if kind in lobes.AREA_KINDS + ("point", "spot"):
         inputs["Position"] = GEOMETRY_INPUTS["Position"]
     inputs.update(lobes.light_geometry_sockets(kind))
     inputs[color_name] = lights.LIGHT_DATA[kind].output_sockets[color_name]
     # only the inputs some lobe or the combination reads
-    used = set(SHADE_SURFACE) | {color_name}.union(*(fn.input_sockets for fn in functions))
+    used = set(surface_terms) | {color_name}.union(*(fn.input_sockets for fn in functions))
     inputs = {k: v for k, v in inputs.items() if k in used}
     title = kind.capitalize() if kind not in lobes.AREA_KINDS else f"{kind.capitalize()} Area"
     return NodeFunction(f"RTL Shade {title} ({features.label()})", shade, inputs,
