@@ -72,6 +72,8 @@ DIFFUSE_LABELS = {
     "lambert": ("Lambert", "Lambertian diffuse"),
     "cod": ("CoD WWII", "Call of Duty WWII multiscattering diffuse (Chan 2018)"),
     "wrapped": ("Wrapped", "Energy-conserving wrapped diffuse (uses the Wrap input)"),
+    "cod_wrapped": ("CoD WWII Wrapped", "Multiscattering diffuse with wrapped lighting, the talk's closing table "
+                                        "(uses the Wrap input)"),
 }
 
 SPECULAR_ITEMS = tuple((m, *SPECULAR_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SPECULAR_MODELS)

@@ -1,4 +1,5 @@
-"""Diffuse BRDFs: Lambert, Call of Duty WWII multiscattering diffuse, normalised wrapped diffuse."""
+"""Diffuse BRDFs: Lambert, Call of Duty WWII multiscattering diffuse, normalised wrapped diffuse, and the two
+combined (multiscattering wrapped diffuse)."""
 from __future__ import annotations
 
 import numpy as np
@@ -45,27 +46,69 @@ def retro_reflection_scale(g):
     return op.maximum((34.5 * g - 59.0) * g + 24.5, 0.0)
 
 
-def cod_multiscatter_diffuse(albedo, mu_l, mu_v, n_dot_h, l_dot_h, alpha):
-    """Call of Duty WWII multiscattering diffuse BRDF (Chan 2018, course notes; the talk).
+def cod_lobe_shape(mu_l, mu_v, n_dot_h, l_dot_h, alpha):
+    """fd + fb of the Call of Duty WWII multiscattering diffuse (Chan 2018; the talk): the BRDF without its
+    albedo / pi and without the horizon test (``cod_multiscatter_diffuse``).
 
-    f = albedo/pi * (fd + fb) with
       f0 = (l.h) + (1 - l.h)^5                               rough limit
-      f1 = (1 - 0.75 (1 - n.l)^5)(1 - 0.75 (1 - n.v)^5)     smooth limit
+      f1 = (1 - 0.75 (1 - n.l)^5)(1 - 0.75 (1 - n.v)^5)     smooth limit (cosines clamped at 0)
       fd = lerp(f0, f1, saturate(2.2 g - 0.5))
       fb = max((34.5 g - 59) g + 24.5, 0) (l.h) 2^(-max(73.2 g - 21.2, 8.9) sqrt(n.h))   retro-reflection
-    The 1/pi belongs to the BRDF (multiply by mu_l for radiance).  Symmetric in l and v
-    (l.h = v.h), so reciprocal.  Zero below either horizon.
-
-    Deviation from the paper: the retro-reflection coefficient is clamped at 0 (``retro_reflection_scale``).
     """
     g = cod_gloss_from_alpha(alpha)
     ldh = op.saturate(l_dot_h)
     f0 = ldh + op.pow5(1.0 - ldh)
     f1 = (1.0 - 0.75 * op.pow5(1.0 - op.saturate(mu_l))) * (1.0 - 0.75 * op.pow5(1.0 - op.saturate(mu_v)))
     fd = op.mix(f0, f1, op.saturate(2.2 * g - 0.5))
+    # n.h < 0 only for light below the horizon (the wrapped form), where sqrt gives 0 (core/ir/semantics.py)
     fb = retro_reflection_scale(g) * ldh * op.exp2(-op.maximum(73.2 * g - 21.2, 8.9) * op.sqrt(n_dot_h))
+    return fd + fb
+
+
+def cod_multiscatter_diffuse(albedo, mu_l, mu_v, n_dot_h, l_dot_h, alpha):
+    """Call of Duty WWII multiscattering diffuse BRDF (Chan 2018, course notes; the talk).
+
+    f = albedo/pi * (fd + fb) (``cod_lobe_shape``).  The 1/pi belongs to the BRDF (multiply by mu_l for
+    radiance).  Symmetric in l and v (l.h = v.h), so reciprocal.  Zero below either horizon.
+
+    Deviation from the paper: the retro-reflection coefficient is clamped at 0 (``retro_reflection_scale``).
+    """
     above = op.logical_and(op.greater(mu_l, 0.0), op.greater(mu_v, 0.0))
-    return op.select(above, albedo * (1.0 / np.pi) * (fd + fb), 0.0)
+    return op.select(above, albedo * (1.0 / np.pi) * cod_lobe_shape(mu_l, mu_v, n_dot_h, l_dot_h, alpha), 0.0)
+
+
+# The talk's "no multiscattering wrapped diffuse", solved in its closing table ("Multiscattering diffuse: direct,
+# indirect and wrapped lighting").  The talk shows how to wrap under area lights (tilt the normal towards the light,
+# integrate the lobe about it, divide by 1 + w), not a wrapped form of the CoD lobe itself; this is ours.  The
+# normalised wrap of Lambert replaces mu_l by the wrapped cosine mu_w = (mu_l + w)/(1 + w) and divides by 1 + w
+# (``wrapped_diffuse_cosine``).  We do the same to the whole CoD lobe: the light direction l is moved, in the plane
+# of n and l, to the direction l_w whose cosine is mu_w, and the CoD BRDF is evaluated there:
+#     f_w(l, v) mu_l  :=  f_CoD(l_w, v) mu_w / (1 + w).
+# Every CoD term (the smooth limit's (1 - n.l)^5, l.h, the retro-reflection's n.h) then stays in the lobe's own
+# domain, w = 0 is the CoD diffuse, a Lambert-like lobe gives the normalised wrapped Lambert exactly, and the
+# directional albedo is the CoD lobe's for every w (substituting mu_w for mu_l maps the wrapped region onto the
+# hemisphere with Jacobian 1 + w), so the SH and area forms keep the CoD table's magnitude.
+def wrapped_light_direction(n, l, wrap, clamp=True):
+    """(l_w, mu_w): the direction l_w in the plane of unit n and l at cosine mu_w = saturate((n.l + w)/(1 + w))
+    from n, w = saturate(wrap); l_w is 0 when l = -n (where mu_w = 0 for w < 1).  ``clamp=False`` keeps the
+    directions beyond the wrap's reach below the horizon (mu_w < 0) instead of on it: a light's corners mapped so
+    keep its shape for the horizon handling of the LTC integrals (core/ltc/shading.py)."""
+    w = op.saturate(wrap)
+    mu = op.dot(n, l)
+    mu_w = (mu + w) / (1.0 + w)
+    if clamp:
+        mu_w = op.saturate(mu_w)
+    tangent = op.normalize(l - op.scale(n, mu))          # normalize of zero is zero (core/ir/semantics.py)
+    return op.scale(n, mu_w) + op.scale(tangent, op.sqrt(1.0 - mu_w * mu_w)), mu_w
+
+
+def cod_wrapped_diffuse_cosine(albedo, n, v, l, alpha, wrap):
+    """Multiscattering wrapped diffuse, the term that replaces f * mu_l: f_CoD(l_w, v) mu_w / (1 + w)
+    (``wrapped_light_direction``) for unit n, v, l; zero below the view's horizon; w in [0, 1]."""
+    l_w, mu_w = wrapped_light_direction(n, l, wrap)
+    h = op.normalize(l_w + v)
+    f = cod_multiscatter_diffuse(albedo, mu_w, op.dot(n, v), op.dot(n, h), op.dot(l_w, h), alpha)
+    return f * mu_w / (1.0 + op.saturate(wrap))
 
 
 def wrapped_diffuse_cosine(mu_l, wrap):

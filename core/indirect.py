@@ -28,7 +28,7 @@ import math
 import numpy as np
 
 from . import shading_ops as op
-from .diffuse import cod_multiscatter_diffuse
+from .diffuse import cod_multiscatter_diffuse, cod_wrapped_diffuse_cosine
 from .ltc import polygon
 
 PI = math.pi
@@ -192,6 +192,14 @@ def sh_cod_diffuse_magnitude_only(tables, coeffs9, n, v, roughness, albedo):
     return op.vmul(op.scale(sh_cosine_lobe_eval(coeffs9, n), magnitude), albedo)
 
 
+def sh_cod_wrapped_diffuse_magnitude_only(tables, coeffs9, n, v, roughness, albedo, wrap):
+    """The "magnitude only" baseline of ``sh_cod_wrapped_diffuse``: the wrapped lobe about N (not the LTC-mapped
+    axis) times the CoD table's magnitude and the albedo."""
+    mu = op.saturate(op.dot(n, v))
+    _, magnitude, _ = tables.ltc(COD_TABLE, mu, roughness)
+    return op.vmul(op.scale(sh_wrapped_lobe_eval(coeffs9, n, wrap), magnitude), albedo)
+
+
 def sh_cod_wrapped_diffuse(tables, coeffs9, n, v, roughness, albedo, wrap, axis="talk"):
     """Multiscattering wrapped diffuse under SH (the talk's "no multiscattering wrapped diffuse"):
     the wrapped lobe (``wrapped_lobe_zonal``) about the LTC-mapped axis, times the CoD magnitude and the
@@ -266,6 +274,32 @@ def cod_diffuse_reference(coeffs, n, v, roughness, n_theta=64, n_phi=128):
     f = cod_multiscatter_diffuse(1.0, mu_l, mu_v, n_dot_h, l_dot_h, alpha)
     radiance = sh_radiance(coeffs, l)
     return np.einsum("...k,...kc->...c", f * mu_l * weights, radiance)
+
+
+def cod_wrapped_diffuse_reference(coeffs, n, v, roughness, wrap, n_theta=64, n_phi=128):
+    """Brute force of the multiscattering wrapped diffuse (``core.diffuse.cod_wrapped_diffuse_cosine``, albedo 1)
+    under the SH radiance: int L(l) f_w(l, v) mu_l dl over the directions with n.l > -w, where it is non-zero
+    (Gauss-Legendre in z = n.l on [-w, 1], so the rule does not straddle the kink at z = -w; midpoint rule in
+    phi).  ``wrap``: a float; numpy, float64; shapes as ``cod_diffuse_reference``."""
+    from .conventions import ALPHA_MIN
+
+    w = float(np.clip(wrap, 0.0, 1.0))
+    n = np.asarray(n, dtype=np.float64)
+    v = np.asarray(v, dtype=np.float64)
+    r = np.asarray(roughness, dtype=np.float64)
+    t1, t2, nn = polygon.local_frame(n, v)
+    x, wx = np.polynomial.legendre.leggauss(n_theta)
+    z, wz = (x + 1.0) * (0.5 * (1.0 + w)) - w, wx * (0.5 * (1.0 + w))
+    phi = (np.arange(n_phi) + 0.5) * (2.0 * PI / n_phi)
+    sz = np.sqrt(np.maximum(1.0 - z * z, 0.0))
+    local = np.stack([sz[:, None] * np.cos(phi)[None, :], sz[:, None] * np.sin(phi)[None, :],
+                      np.broadcast_to(z[:, None], (n_theta, n_phi))], axis=-1).reshape(-1, 3)
+    weights = np.broadcast_to((wz * (2.0 * PI / n_phi))[:, None], (n_theta, n_phi)).reshape(-1)
+    l = (local[:, 0, None] * t1[..., None, :] + local[:, 1, None] * t2[..., None, :]
+         + local[:, 2, None] * nn[..., None, :])
+    alpha = np.maximum(r * r, ALPHA_MIN)[..., None]
+    f_cos = cod_wrapped_diffuse_cosine(1.0, nn[..., None, :], v[..., None, :], l, alpha, w)
+    return np.einsum("...k,...kc->...c", f_cos * weights, sh_radiance(coeffs, l))
 
 
 def sh_project(fn, n_theta=96, n_phi=192):

@@ -24,7 +24,9 @@ MEASURED = {
 # Rough cost order of the switches, for feature sets that were not measured: a measured set at least as
 # costly in every switch bounds the capacity from below.
 _SPECULAR_COST = {"none": 0, "single": 0, "turquin": 1, "fdez_aguera": 1, "kulla_conty": 2}
-_DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1}
+#: cod_wrapped: the CoD lobe plus the wrapped normal's tilt, costlier than either (no measured set bounds it yet,
+#: so it takes the smallest measured capacity).
+_DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1, "cod_wrapped": 2}
 
 
 def _at_least_as_costly(measured, features):

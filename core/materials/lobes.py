@@ -184,6 +184,24 @@ WRAPPED = Lobe("wrapped", "Wrapped Diffuse", ("Wrap",), {"Diffuse": _OUT}, _wrap
                "Wrapped diffuse: clamped cosine about the tilted normal, / (1 + w) (the talk)")
 
 
+# --- multiscattering wrapped diffuse (the talk's closing table: CoD diffuse with wrapped lighting) ----------
+# Punctual: the CoD lobe at the wrapped light direction (core/diffuse.py: its definition and properties).  Area:
+# the talk's tilted normal (WrappedNormal towards the light's centre) with the CoD LTC integrated about it, / (1 + w).
+
+def _cod_wrapped_punctual(tables, N, V, L, Roughness, Wrap):
+    return {"Diffuse": diffuse.cod_wrapped_diffuse_cosine(1.0, N, V, L, alpha_from_roughness(Roughness), Wrap)}
+
+
+def _cod_wrapped_area(tables, light, Position, N, V, Roughness, Wrap):
+    return {"Diffuse": shading.cod_wrapped_diffuse(tables, light, Position, N, V, Roughness, 1.0, Wrap)}
+
+
+COD_WRAPPED = Lobe("cod_wrapped", "CoD Wrapped Diffuse", ("Roughness", "Wrap"), {"Diffuse": _OUT},
+                   _cod_wrapped_punctual, _cod_wrapped_area,
+                   "CoD WWII multiscattering diffuse (albedo 1) at the wrapped light direction, / (1 + w)",
+                   "CoD WWII diffuse LTC about the normal tilted towards the light (the talk), / (1 + w)")
+
+
 # --- Ashikhmin cloth with Neubelt-Pettineo visibility -------------------------------------------------
 
 def _cloth_punctual(tables, N, V, L, Roughness):
@@ -217,7 +235,7 @@ SHEEN = Lobe("sheen", "Sheen", (), {"Sheen": _OUT}, _sheen_punctual, _sheen_area
 
 
 #: Every lobe, by key, in Add > Group order.
-LOBES = {lobe.key: lobe for lobe in (GGX, KULLA_CONTY, LAMBERT, COD, WRAPPED, CLOTH, SHEEN)}
+LOBES = {lobe.key: lobe for lobe in (GGX, KULLA_CONTY, LAMBERT, COD, WRAPPED, COD_WRAPPED, CLOTH, SHEEN)}
 
 
 # --- node functions -----------------------------------------------------------------------------------

@@ -20,7 +20,8 @@ from ..ir.interface import Socket, color, factor, scalar, vector
 #: "none" switches the specular lobe off (no GGX lobe, tables or world specular term in the tree): a
 #: diffuse-only material, e.g. for checking the diffuse models alone.
 SPECULAR_MODELS = ("single", "turquin", "fdez_aguera", "kulla_conty", "none")
-DIFFUSE_MODELS = ("lambert", "cod", "wrapped")
+#: "cod_wrapped": the CoD multiscattering diffuse with the Wrap input (the talk's multiscattering wrapped diffuse).
+DIFFUSE_MODELS = ("lambert", "cod", "wrapped", "cod_wrapped")
 #: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
 #: the prefiltered radiance (the talk's approximation); core/materials/world.py.
 ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")
@@ -36,7 +37,8 @@ RT_LIT_INPUTS = {
     "Specular IOR Level": factor(0.5, "Scales the dielectric F0 by 2 x level (0.5 keeps it), as Principled",
                                  "Specular"),
     "Specular Tint": color((1.0, 1.0, 1.0, 1.0), "Tint of the dielectric F0", "Specular"),
-    "Wrap": factor(0.0, "Wrapped-diffuse amount w (used when the diffuse model is 'wrapped')", "Diffuse"),
+    "Wrap": factor(0.0, "Wrapped-diffuse amount w (used by the 'wrapped' and 'cod_wrapped' diffuse models)",
+                   "Diffuse"),
     "Sheen Weight": factor(0.0, "Disney sheen amount (used when sheen is switched on)", "Sheen"),
     "Sheen Tint": color((1.0, 1.0, 1.0, 1.0), "Colour of the Disney sheen", "Sheen"),
     "Cloth Weight": factor(0.0, "Blend from the specular lobe to the Ashikhmin cloth lobe (cloth switched on)",

@@ -4,7 +4,8 @@ The talk's "Light Type" tables list what each technique needs under an environme
 that column, written with ``core.shading_ops`` so one source gives numpy evaluation and node groups:
 
 * diffuse from L2 spherical harmonics (``core/indirect.py``): Lambert irradiance, the normalised
-  wrapped lobe, and the talk's LTC-rotated cosine lobe for the CoD multiscattering diffuse;
+  wrapped lobe, and the talk's LTC-rotated cosine lobe for the CoD multiscattering diffuse (wrapped:
+  the normalised wrapped lobe about that axis);
 * specular by the split sum (Karis 2013): GGX-prefiltered radiance (``core/environment/prefilter.py``)
   looked up along the dominant specular direction (Lagarde & de Rousiers 2014), times the environment
   BRDF (F0 scale + bias); multiple scattering by the material's specular model (below), evaluated
@@ -33,8 +34,7 @@ radiance, I = E(n)/pi the cosine-weighted mean radiance (SH):
 
 Mixing the two F0 *after* these formulas is what three.js (#32190) and Bevy (#23203) got wrong:
 they are non-linear in F0, so a mixed F0 = lerp(F0_dielectric, base colour, metallic) over-brightens
-partly metallic surfaces.  The punctual and area lights of RT Lit still use the mixed F0 (their
-models are linear in F0 except Turquin's and Fdez-Aguera's scales; documented in docs/conventions.md).
+partly metallic surfaces.  The lights shade the two apart too (light_shading.SPLIT_F0_MODELS).
 
 Specular dominant direction (Lagarde & de Rousiers 2014, "Moving Frostbite to PBR", listing 22):
 lerp(N, R, s (sqrt(s) + alpha)) with s = 1 - alpha, alpha = r^2, R the mirror direction.
@@ -344,6 +344,11 @@ def world_radiance(tables, features, env, surface, params):
         diffuse = irradiance
     elif features.diffuse == "wrapped":
         diffuse = sh_lobe(coeffs, n, indirect.wrapped_lobe_zonal(surface["Wrap"]))
+    elif features.diffuse == "cod_wrapped":
+        # multiscattering wrapped diffuse (indirect.sh_cod_wrapped_diffuse): the wrapped lobe about the CoD LTC axis
+        lobe = SH_LTC_COD(tables, N=n, V=v, Roughness=r)
+        diffuse = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.wrapped_lobe_zonal(surface["Wrap"])),
+                           lobe["Magnitude"])
     else:
         lobe = SH_LTC_COD(tables, N=n, V=v, Roughness=r)
         diffuse = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])

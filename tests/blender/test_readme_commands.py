@@ -40,6 +40,7 @@ RUN_BY = {
     "scripts/benchmark_environment.py": "here",
     "scripts/benchmark_rt_lit.py": "here",
     "scripts/build_presets.py": "here",
+    "scripts/benchmark_wrapped_diffuse.py": "here",
 }
 
 #: The commands run here: (script, arguments, files it must write under the output folder).
@@ -52,6 +53,8 @@ SMOKE = {
                                           "--out", "{out}/environment.md"], ["environment.md", "environment.json"]),
     "scripts/benchmark_rt_lit.py": (["--quick", "--out", "{out}"], ["rt_lit.md", "rt_lit.json"]),
     "scripts/build_presets.py": (["--out", "{out}"], ["rt_lookdev_presets.blend", "blender_assets.cats.txt"]),
+    "scripts/benchmark_wrapped_diffuse.py": (["--quick", "--lights", "4", "--out", "{out}"],
+                                             ["wrapped_diffuse.md", "wrapped_diffuse.json"]),
 }
 
 

@@ -39,6 +39,30 @@ def test_finite_and_float32(name):
     assert np.all(np.isfinite(value))
 
 
+def _directions():
+    """Unit float32 directions: the poles, the equator, tiny tilts, and random ones."""
+    rng = np.random.default_rng(4)
+    special = [[0, 0, 1], [0, 0, -1], [1, 0, 0], [0, 1e-7, 1], [0, 1e-7, -1], [1e-20, 0, -1]]
+    rand = rng.normal(size=(10, 3))
+    d = np.concatenate([np.asarray(special, np.float64), rand])
+    return (d / np.linalg.norm(d, axis=-1, keepdims=True)).astype(F)
+
+
+def test_cod_wrapped_diffuse_float32_degenerate():
+    """The multiscattering wrapped diffuse at float32 extremes: light at -N (its wrapped direction is 0), light and
+    view at the poles, w = 0 and 1, alpha at the floor."""
+    d = _directions()
+    n = np.broadcast_to(np.array([0, 0, 1], F), (len(d), len(d), 3))
+    l, v = np.broadcast_arrays(d[:, None, :], d[None, :, :])
+    for w in (F(0.0), F(1e-7), F(0.5), F(1.0)):
+        for alpha in (F(0.0), F(1e-4), F(1.0)):
+            with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+                direction, mu_w = diffuse.wrapped_light_direction(n, l, w, clamp=False)
+                value = diffuse.cod_wrapped_diffuse_cosine(F(1.0), n, v, l, alpha, w)
+            assert value.dtype == direction.dtype == mu_w.dtype == np.float32
+            assert np.all(np.isfinite(value)) and np.all(np.isfinite(direction)) and np.all(value >= 0)
+
+
 def test_wrapped_normal_float32_degenerate():
     n = np.array([[0, 0, 1]] * 3, dtype=F)
     l = np.array([[0, 0, -1], [0, 0, 1], [1, 0, 0]], dtype=F)
