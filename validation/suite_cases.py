@@ -47,6 +47,10 @@ from ..core.materials.rt_lit_interface import Features
 WHITE = (1.0, 1.0, 1.0)
 BLACK = (0.0, 0.0, 0.0)
 
+MIX_TRUTH = ("{} at Metallic 0.5 (copper base colour, IOR 1.5) vs Cycles' Mix Shader of the dielectric (Metallic "
+             "BSDF Multiscatter GGX, F82 white, F0 0.04, + Diffuse BSDF) and the metal (Metallic BSDF Multiscatter GGX, "
+             "F82 white, F0 = base colour)")
+
 #: Technique -> (RT Lit features, truth kind, short description).
 TECHNIQUES = {
     "lambert": (Features("none", "lambert"), "cycles", "Lambert diffuse vs Cycles Diffuse BSDF"),
@@ -61,13 +65,24 @@ TECHNIQUES = {
               "GGX with coloured Schlick F0 vs Cycles Metallic BSDF (GGX, F82 white tint)"),
     "cod": (Features("none", "cod"), "brute", "CoD WWII multiscattering diffuse vs its integral"),
     "wrapped": (Features("none", "wrapped"), "brute", "wrapped diffuse vs its integral"),
+    "cod_wrapped": (Features("none", "cod_wrapped"), "brute",
+                    "CoD multiscattering wrapped diffuse (tilted normal + CoD LTC) vs the integral of its BRDF"),
     "cloth": (Features("none", "lambert", cloth=True), "brute", "Ashikhmin cloth vs its integral"),
     "sheen": (Features("none", "lambert", sheen=True), "brute", "Disney sheen vs its integral"),
     "kulla_conty": (Features("kulla_conty", "lambert"), "brute",
                     "Kulla-Conty GGX with coloured F0 vs the integral of f_ss + F_ms f_ms"),
     "turquin_color": (Features("turquin", "lambert"), "brute",
                       "Turquin GGX with coloured F0 vs the integral of its BRDF f_ss (1 + F0 (1 - E)/E)"),
+    "kulla_conty_white": (Features("kulla_conty", "lambert"), "cycles",
+                          "Kulla-Conty GGX, F0 = 1, vs Cycles Glossy Multiscatter GGX"),
+    # Metallic 0.5 (issue 17, item 5): the dielectric and the metal shaded apart and mixed, against the same mix
+    # of Cycles closures, each with Cycles' own multiple scattering (Metallic BSDF Multiscatter GGX)
+    "mix_turquin": (Features("turquin", "lambert"), "cycles", MIX_TRUTH.format("Turquin")),
+    "mix_fdez_aguera": (Features("fdez_aguera", "lambert"), "cycles", MIX_TRUTH.format("Fdez-Aguera (talk's area form)")),
+    "mix_kulla_conty": (Features("kulla_conty", "lambert"), "cycles", MIX_TRUTH.format("Kulla-Conty")),
 }
+#: The metallic-mix techniques' Metallic.
+MIX_METALLIC = 0.5
 
 
 def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
@@ -76,12 +91,15 @@ def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
     removes the diffuse where only cloth or sheen is measured."""
     m = {"Roughness": float(roughness), "Base Color": WHITE, "Metallic": 0.0, "Cloth Weight": 0.0,
          "Cloth Color": BLACK, "Sheen Weight": 0.0, "Wrap": 0.0}
-    if technique in ("lambert", "cod", "wrapped"):
+    if technique in ("lambert", "cod", "wrapped", "cod_wrapped"):
         m.update({"Base Color": color or WHITE})
-        if technique == "wrapped":
+        if technique in ("wrapped", "cod_wrapped"):
             m["Wrap"] = float(wrap)
-    elif technique in ("ggx", "turquin", "fdez_aguera"):
+    elif technique in ("ggx", "turquin", "fdez_aguera", "kulla_conty_white"):
         m.update({"Metallic": 1.0, "Base Color": WHITE})
+    elif technique.startswith("mix_"):
+        m.update({"Metallic": MIX_METALLIC, "Base Color": color or (0.95, 0.64, 0.54), "IOR": 1.5,
+                  "Specular IOR Level": 0.5})
     elif technique in ("metal", "kulla_conty", "turquin_color"):
         m.update({"Metallic": 1.0, "Base Color": color or (0.95, 0.64, 0.54)})
     elif technique == "dielectric":
@@ -116,7 +134,7 @@ class Variant:
     @property
     def label(self):
         s = f"{self.technique} r={self.roughness:g}"
-        if self.technique == "wrapped":
+        if self.technique in ("wrapped", "cod_wrapped"):
             s += f" w={self.wrap:g}"
         return s
 
@@ -210,7 +228,8 @@ def build_cases(seed=0, quick=False):
                    Variant("metal", 0.5)]
     brute_row = [Variant("cod", 0.5), Variant("wrapped", 0.5, wrap=0.5), Variant("cloth", 0.5),
                  Variant("sheen", 0.5), Variant("kulla_conty", 0.7), Variant("turquin_color", 0.7),
-                 Variant("lambert"), Variant("ggx", 0.5)]
+                 Variant("lambert"), Variant("ggx", 0.5), Variant("cod_wrapped", 0.5, wrap=0.5),
+                 Variant("cod_wrapped", 0.8, wrap=1.0)]
     cases = []
     # area lights: (kind, size, size_y, distance, tilt deg, elevation range)
     configs = [("quad", 1.0, None, 3.0, 0.0), ("quad", 2.5, 1.2, 2.5, 25.0), ("quad", 0.5, None, 4.0, 10.0),
@@ -261,7 +280,8 @@ def build_cases(seed=0, quick=False):
                       tags={"light": "disk"}))
     # punctual lights (deterministic in Cycles: radius 0 / angle 0)
     punctual_row = [Variant("lambert"), Variant("ggx", 0.3), Variant("ggx", 0.7), Variant("turquin", 0.6),
-                    Variant("dielectric", 0.4), Variant("metal", 0.5)]
+                    Variant("dielectric", 0.4), Variant("metal", 0.5), Variant("fdez_aguera", 0.6),
+                    Variant("kulla_conty_white", 0.6)]
     cases.append(Case("point", [LightSpec("point", (1.5, -3.0, 1.5), 400.0)], punctual_row, columns=3,
                       description="point light, radius 0", tags={"light": "point"}))
     cases.append(Case("spot", [LightSpec("spot", (-1.0, -4.0, 2.0), 800.0, spot_size=1.0, spot_blend=0.3)],
@@ -269,6 +289,23 @@ def build_cases(seed=0, quick=False):
                       tags={"light": "spot"}))
     cases.append(Case("sun", [LightSpec("sun", (0.0, -3.0, 3.0), 2.0, target=(0.3, 0.0, -0.2))], punctual_row,
                       columns=3, description="sun, angle 0", tags={"light": "sun"}))
+    # the techniques without a Cycles closure under the punctual lights: their exact BRDF, evaluated in float64
+    # numpy from the light's own data (issue 17, item 6)
+    punctual_brute = [Variant("cod", 0.5), Variant("wrapped", 0.5, wrap=0.5), Variant("cloth", 0.5),
+                      Variant("sheen", 0.5), Variant("kulla_conty", 0.7), Variant("turquin_color", 0.7),
+                      Variant("cod_wrapped", 0.5, wrap=0.5)]
+    for case in [c for c in cases if c.name in ("point", "spot", "sun")]:
+        cases.append(Case(f"{case.name}_brute", case.lights, punctual_brute, columns=3,
+                          description=f"{case.description}: techniques without a Cycles closure, against their "
+                                      "BRDF at the light's direction", tags=dict(case.tags)))
+    # Metallic 0.5 under each kind of light: the multiple-scattering models with dielectric and metal apart
+    mix_row = [Variant(t, r) for t in ("mix_turquin", "mix_fdez_aguera", "mix_kulla_conty") for r in (0.3, 0.6, 0.9)]
+    for spec in (LightSpec("quad", (1.5, -3.0, 2.0), _area_power("quad", 2.0, 1.0, 3.0, 4.5), 2.0, 1.0),
+                 LightSpec("disk", (-2.0, -2.5, 1.5), _area_power("disk", 1.5, None, 3.0, 4.0), 1.5),
+                 LightSpec("point", (1.5, -3.0, 1.5), 400.0)):
+        cases.append(Case(f"metallic_mix_{spec.kind}", [spec], mix_row, columns=3,
+                          description=f"{spec.describe()}: Turquin, Fdez-Aguera, Kulla-Conty (rows) at Metallic 0.5, "
+                                      "r = 0.3, 0.6, 0.9", tags={"light": spec.kind}))
     return cases
 
 
@@ -454,9 +491,9 @@ def _closure_material(variant, name):
         g.inputs["Anisotropy"].default_value = 0.0
         return g
 
-    def metallic(f0):
+    def metallic(f0, dist="GGX"):
         g = nt.nodes.new("ShaderNodeBsdfMetallic")
-        g.distribution = "GGX"
+        g.distribution = dist
         g.fresnel_type = "F82"
         g.inputs["Base Color"].default_value = tuple(f0) + (1.0,)
         g.inputs["Edge Tint"].default_value = (1.0, 1.0, 1.0, 1.0)
@@ -474,18 +511,25 @@ def _closure_material(variant, name):
         shader = diffuse(m["Base Color"])
     elif t == "ggx":
         shader = glossy("GGX")
-    elif t in ("turquin", "fdez_aguera"):
+    elif t in ("turquin", "fdez_aguera", "kulla_conty_white"):
         shader = glossy("MULTI_GGX")
     elif t == "metal":
         shader = metallic(m["Base Color"])
-    elif t == "dielectric":
+    elif t == "dielectric" or t.startswith("mix_"):
         from ..core.materials.surface import dielectric_f0
 
+        dist = "MULTI_GGX" if t.startswith("mix_") else "GGX"
         f0 = float(dielectric_f0(np.float64(m["IOR"]), np.float64(m["Specular IOR Level"])))
         add = nt.nodes.new("ShaderNodeAddShader")
-        nt.links.new(metallic((f0, f0, f0)).outputs[0], add.inputs[0])
+        nt.links.new(metallic((f0, f0, f0), dist).outputs[0], add.inputs[0])
         nt.links.new(diffuse(m["Base Color"]).outputs[0], add.inputs[1])
         shader = add
+        if t.startswith("mix_"):
+            mix = nt.nodes.new("ShaderNodeMixShader")
+            mix.inputs["Fac"].default_value = m["Metallic"]
+            nt.links.new(add.outputs[0], mix.inputs[1])
+            nt.links.new(metallic(m["Base Color"], dist).outputs[0], mix.inputs[2])
+            shader = mix
     else:
         raise ValueError(f"{t} has no Cycles closure")
     nt.links.new(shader.outputs[0], out.inputs["Surface"])
@@ -610,7 +654,7 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
         features = variant.features
         material = numpy_material(variant)
         shade = functools.partial(light_shading.shade_function("sun", features), tables)
-        unclipped = features.diffuse == "wrapped"
+        unclipped = features.diffuse in ("wrapped", "cod_wrapped")
         P = pos[ys, xs]
         N = nrm[ys, xs] / np.linalg.norm(nrm[ys, xs], axis=-1, keepdims=True)
         V = camera_incoming(scene, P)
@@ -727,7 +771,8 @@ def cycles_error_exponent(variant):
     """k of Cycles' error ~ spp^-k for a suite variant (``CYCLES_ERROR_EXPONENTS`` by its family)."""
     if variant.technique == "lambert":
         return CYCLES_ERROR_EXPONENTS["diffuse"]
-    if variant.technique in ("ggx", "turquin", "fdez_aguera", "dielectric", "metal"):
+    if variant.technique in ("ggx", "turquin", "fdez_aguera", "dielectric", "metal", "kulla_conty_white") \
+            or variant.technique.startswith("mix_"):
         return CYCLES_ERROR_EXPONENTS["glossy" if variant.roughness <= GLOSSY_MAX_ROUGHNESS else "rough"]
     return CYCLES_ERROR_EXPONENT
 

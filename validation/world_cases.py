@@ -55,6 +55,9 @@ TECHNIQUES = {
     "lambert": (Features("none", "lambert"), "DIFFUSE", "Lambert (SH irradiance) vs Cycles Diffuse BSDF"),
     "cod": (Features("none", "cod"), None,
             "CoD WWII diffuse (the talk's SH-LTC lobe) vs the brute-force integral of its BRDF"),
+    "cod_wrapped": (Features("none", "cod_wrapped"), None,
+                    "multiscattering wrapped diffuse, w = 0.5 (the wrapped lobe about the CoD SH-LTC axis) vs the "
+                    "brute-force integral of its BRDF"),
     "ggx": (Features("single", "lambert"), "GGX", "single-scattering split sum, F0 = 1, vs Cycles Glossy GGX"),
     "turquin": (Features("turquin", "lambert"), "MULTI_GGX",
                 "Turquin split sum, F0 = 1, vs Cycles Glossy Multiscatter GGX"),
@@ -74,7 +77,7 @@ def technique_material(technique, roughness):
     specular: ``TECHNIQUES``), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
     from . import suite_cases as suite
 
-    base = technique if technique in ("lambert", "cod") else "ggx"
+    base = technique if technique in ("lambert", "cod", "cod_wrapped") else "ggx"
     return suite.technique_material(base, roughness)
 
 
@@ -93,7 +96,9 @@ class WorldVariant(Variant):
 
     @property
     def label(self):
-        return self.technique if self.technique == "lambert" else f"{self.technique} r={self.roughness:g}"
+        if self.technique == "lambert":
+            return self.technique
+        return f"{self.technique} r={self.roughness:g}" + (f" w={self.wrap:g}" if self.technique == "cod_wrapped" else "")
 
     def material(self):
         return technique_material(self.technique, self.roughness)
@@ -123,7 +128,7 @@ def node_variants(quick=False, kulla_conty=True):
     out = [WorldVariant("lambert")]
     techs = ["cod", "ggx", "turquin", "fdez_aguera", "fdez_aguera_radiance"]
     if kulla_conty and not quick:
-        techs.append("kulla_conty")
+        techs += ["kulla_conty", "cod_wrapped"]
     for t in techs:
         out += [WorldVariant(t, r) for r in rough]
     return out
@@ -400,11 +405,13 @@ def lambert_reference_image(quad, n, chunk=512):
     return out
 
 
-def cod_reference_image(quad, n, v, roughness, chunk=64):
+def cod_reference_image(quad, n, v, roughness, chunk=64, wrap=None):
     """Brute force of the true CoD WWII BRDF (albedo 1) over the image's texels:
-    int L(l) f_CoD(l, v) (n.l) dl, n and v (K, 3) unit in the image frame, roughness (K,) -> (K, 3)."""
+    int L(l) f_CoD(l, v) (n.l) dl, n and v (K, 3) unit in the image frame, roughness (K,) -> (K, 3).
+    With ``wrap`` (a float): the multiscattering wrapped diffuse instead (``core.diffuse.cod_wrapped_diffuse_cosine``,
+    whose support reaches below the horizon)."""
     from ..core.conventions import ALPHA_MIN
-    from ..core.diffuse import cod_multiscatter_diffuse
+    from ..core.diffuse import cod_multiscatter_diffuse, cod_wrapped_diffuse_cosine
 
     dirs, wts, rad = quad
     n = np.asarray(n, np.float64)
@@ -420,6 +427,10 @@ def cod_reference_image(quad, n, v, roughness, chunk=64):
         n_dot_h = np.einsum("kti,ki->kt", h, nn)
         l_dot_h = np.einsum("kti,ti->kt", h, dirs)
         alpha = np.maximum(rr * rr, ALPHA_MIN)[:, None]
+        if wrap is not None:
+            f_cos = cod_wrapped_diffuse_cosine(1.0, nn[:, None, :], vv[:, None, :], dirs[None, :, :], alpha, wrap)
+            out[s:s + chunk] = (f_cos * wts[None, :]) @ rad
+            continue
         f = cod_multiscatter_diffuse(1.0, mu_l, mu_v, n_dot_h, l_dot_h, alpha)
         out[s:s + chunk] = (f * np.maximum(mu_l, 0.0) * wts[None, :]) @ rad
     return out

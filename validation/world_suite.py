@@ -127,21 +127,23 @@ def _view_cosine(scene, passes):
 
 # --- one world: studies ------------------------------------------------------------------------------
 
-def cod_study(spec, bake, image, variants, block, scene, passes, index, a, args, rng, tables):
-    """Item 2 on up to ``--cod-pixels`` seeded pixels of every CoD sphere: the SH-LTC lobe (numpy
-    float64, and (a)) and the magnitude-only baseline vs the brute-force integrals of the true BRDF under
-    the SH environment and under the area-averaged image.  Image frame: n, v rotated by the Mapping's R."""
+def cod_study(spec, bake, image, variants, block, scene, passes, index, a, args, rng, tables, technique="cod"):
+    """Item 2 on up to ``--cod-pixels`` seeded pixels of every CoD sphere (``technique`` "cod", or "cod_wrapped":
+    the multiscattering wrapped diffuse at the variant's wrap): the SH-LTC lobe (numpy float64, and (a)) and the
+    magnitude-only baseline vs the brute-force integrals of the true BRDF under the SH environment and under the
+    area-averaged image.  Image frame: n, v rotated by the Mapping's R."""
     R = vw.euler_xyz_matrix(spec.rotation)
     coeffs = np.asarray(bake.sh_image, np.float64)
     quad = vw.image_quadrature(image, (args.cod_image, args.cod_image // 2))
     rows, parts = [], {k: [] for k in ("ltc", "mag", "node", "ref_sh", "ref_img")}
     t0 = time.perf_counter()
     for i, v in enumerate(variants):
-        if v.technique != "cod":
+        if v.technique != technique:
             continue
         ys, xs = _pick_pixels(*np.nonzero(index == i), args.cod_pixels, rng)
         ni, vi = _image_frame(scene, passes["Normal"][ys, xs], passes["Position"][ys, xs], R)
-        vals = _cod_values(spec, tables, coeffs, quad, ni, vi, v.roughness, a[ys, xs])
+        wrap = v.wrap if technique == "cod_wrapped" else None
+        vals = _cod_values(spec, tables, coeffs, quad, ni, vi, v.roughness, a[ys, xs], wrap)
         for k in parts:
             parts[k].append(vals[k])
         rows.append(_cod_row(vals, v.roughness, len(ys), args))
@@ -151,14 +153,22 @@ def cod_study(spec, bake, image, variants, block, scene, passes, index, a, args,
             "image_quadrature": [args.cod_image, args.cod_image // 2], "seconds": time.perf_counter() - t0}
 
 
-def _cod_values(spec, tables, coeffs, quad, ni, vi, roughness, node):
+def _cod_values(spec, tables, coeffs, quad, ni, vi, roughness, node, wrap=None):
     """One CoD sphere's pixels: the SH-LTC lobe and the magnitude-only baseline (numpy float64), the node
-    render's values, and the brute-force references under the SH environment and under the image."""
+    render's values, and the brute-force references under the SH environment and under the image; ``wrap``: the
+    multiscattering wrapped diffuse's (None: the CoD diffuse)."""
     from ..core import indirect
 
     r = np.full(len(ni), roughness)
     white = np.ones(3)
     s = spec.strength
+    if wrap is not None:
+        cl = indirect.coefficient_list(coeffs)
+        return {"ltc": s * indirect.sh_cod_wrapped_diffuse(tables, cl, ni, vi, roughness, white, wrap),
+                "mag": s * indirect.sh_cod_wrapped_diffuse_magnitude_only(tables, cl, ni, vi, roughness, white, wrap),
+                "node": node.astype(np.float64),
+                "ref_sh": s * indirect.cod_wrapped_diffuse_reference(coeffs, ni, vi, r, wrap),
+                "ref_img": s * vw.cod_reference_image(quad, ni, vi, r, wrap=wrap)}
     return {"ltc": s * indirect.sh_cod_diffuse(tables, indirect.coefficient_list(coeffs), ni, vi, roughness, white),
             "mag": s * indirect.sh_cod_diffuse_magnitude_only(tables, indirect.coefficient_list(coeffs), ni, vi,
                                                               roughness, white),
@@ -452,7 +462,9 @@ def _studies(spec, variants, ws, nr, truth, lambert_truth, lambert_mask, args, r
     lam = lambert_study(spec, ws.image, variants, ws.nb, ws.scene, nr.passes, nr.index, nr.a, lambert_truth,
                         lambert_mask, args)
     ggx = ggx_study(spec, ws.image, variants, ws.nb, ws.scene, nr.passes, nr.a, truth, ws.closures, args, rng, tables)
-    return cod, lam, ggx
+    cod_wrapped = cod_study(spec, ws.bake, ws.image, variants, ws.nb, ws.scene, nr.passes, nr.index, nr.a, args, rng,
+                            tables, technique="cod_wrapped")
+    return cod, lam, ggx, cod_wrapped
 
 
 def _write_world_images(folder, nr, truth, c_full, args):
@@ -480,7 +492,7 @@ def _write_world_images(folder, nr, truth, c_full, args):
 
 def _world_record(spec, ws, nr, entries, studies, bake_times, timing, gate_cod, png):
     """The world's entry of report.json."""
-    cod, lam, ggx = studies
+    cod, lam, ggx, cod_wrapped = studies
     cod_ok = None
     if cod is not None:
         p = cod["pooled"]
@@ -489,6 +501,7 @@ def _world_record(spec, ws, nr, entries, studies, bake_times, timing, gate_cod, 
             "rotation": list(spec.rotation), "strength": spec.strength,
             "image": list(ws.nb.resolution), "truth_image": list(ws.tb.resolution) if ws.tb else None,
             "ab": nr.ab, "ab_ok": bool(nr.ab_ok), "variants": entries, "cod": cod, "cod_ok": cod_ok,
+            "cod_wrapped": cod_wrapped,
             "ggx_harness": ggx, "gate_cod": gate_cod, "lambert": lam, "bake": bake_times, "timing_s": timing,
             "world_parameters": {k: (list(v) if isinstance(v, (tuple, list, np.ndarray)) else v)
                                  for k, v in ws.params.items()},
@@ -664,11 +677,16 @@ def _md_lambert(result):
 
 
 def _md_cod(result):
-    """Item 2: the CoD study per world, pooled per roughness, and per world and roughness."""
-    return _md_cod_worlds(result) + _md_cod_pooled(result) + _md_cod_per_roughness(result)
+    """Item 2: the CoD study per world, pooled per roughness, and per world and roughness; the multiscattering
+    wrapped diffuse's beside it."""
+    wrapped = ["", "### Multiscattering wrapped diffuse (CoD + wrap, w = 0.5): the wrapped lobe about the SH-LTC axis vs "
+                   "about N", ""] + _md_cod_worlds(result, "cod_wrapped")[5:] + _md_cod_per_roughness(result, "cod_wrapped")
+    has_wrapped = any(w.get("cod_wrapped") for w in result["worlds"])
+    return (_md_cod_worlds(result) + _md_cod_pooled(result) + _md_cod_per_roughness(result)
+            + (wrapped if has_wrapped else []))
 
 
-def _md_cod_worlds(result):
+def _md_cod_worlds(result, key="cod"):
     L = ["", "## 2. CoD WWII diffuse: SH-LTC lobe vs magnitude only, against brute force of the true BRDF", "",
          "Per world, pooled over the CoD spheres (r in the sweep), seeded pixels: mean (median, p90) relative error. "
          "'SH env' = the BRDF integrated against the SH-projected environment (the lobe approximation alone); "
@@ -676,7 +694,7 @@ def _md_cod_worlds(result):
          "| world | SH-LTC vs SH env | magnitude only vs SH env | SH-LTC vs image | magnitude only vs image | "
          "(a) vs numpy SH-LTC (max) |", "|---|---|---|---|---|---|"]
     for w in result["worlds"]:
-        c = w.get("cod")
+        c = w.get(key)
         if not c:
             continue
         p = c["pooled"]
@@ -699,11 +717,11 @@ def _md_cod_pooled(result):
     return L
 
 
-def _md_cod_per_roughness(result):
+def _md_cod_per_roughness(result, key="cod"):
     L = ["", "Per world and roughness (mean errors):", "",
          "| world | r | SH-LTC / mag-only vs SH env | SH-LTC / mag-only vs image |", "|---|---|---|---|"]
     for w in result["worlds"]:
-        c = w.get("cod")
+        c = w.get(key)
         if not c:
             continue
         for row in c["per_roughness"]:
