@@ -7,8 +7,8 @@ Registration reads no file (it only checks that the preset library exists, to li
 """
 import bpy
 
-from . import (compat, convert, export_operators, light_sync, lookdev_operators, operators, preferences, preset_assets,
-               switches, ui)
+from . import (compat, convert, export_operators, light_controls, light_sync, lookdev_operators, operators, preferences,
+               preset_assets, switches, ui)
 
 classes = (
     *operators.classes,
@@ -18,6 +18,7 @@ classes = (
     *preferences.classes,
     *switches.classes,
     *ui.classes,
+    *light_controls.classes,
 )
 #: (menu, draw function): entries appended to Blender's menus (File > Export, 3D viewport > Add).
 menus = (*export_operators.menus, *lookdev_operators.menus)
@@ -33,6 +34,7 @@ def register():
     for menu, draw in menus:
         menu.append(draw)
     switches.register()
+    light_controls.register()
     light_sync.register()
     preset_assets.register_library()
 
@@ -40,6 +42,7 @@ def register():
 def unregister():
     preset_assets.unregister_library()
     light_sync.unregister()
+    light_controls.unregister()
     switches.unregister()
     for menu, draw in reversed(menus):
         menu.remove(draw)

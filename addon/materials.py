@@ -26,7 +26,7 @@ from ..core.lut.lookup import LutSet
 from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, RT_LIT_OUTPUTS,
                                                Features, light_input, rt_lit_group_name)
-from . import compat, node_emit, world_sync
+from . import compat, light_controls, node_emit, world_sync
 from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LIGHTS_SIGNATURE_KEY, RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME,
                      SCENE_LIGHTS_GROUP, STAMP_KEY,
                      WORLD_GROUP, add_driver, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers,
@@ -38,13 +38,16 @@ _GEOMETRY_SOCKETS = {"Position": "Position", "Geometry Normal": "Normal", "Incom
 
 
 def light_kind(obj):
-    """The RT Lit light kind of a light object, or None if RT Lit does not shade it."""
+    """The RT Lit light kind of a light object with its controls ("quad+cone+range", addon/light_controls.py),
+    or None if RT Lit does not shade it."""
     if obj.type != "LIGHT":
         return None
     data = obj.data
     if data.type == "AREA":
-        return _AREA_SHAPES.get(data.shape)
-    return {"POINT": "point", "SPOT": "spot", "SUN": "sun"}.get(data.type)
+        base = _AREA_SHAPES.get(data.shape)
+    else:
+        base = {"POINT": "point", "SPOT": "spot", "SUN": "sun"}.get(data.type)
+    return None if base is None else light_controls.light_kind(data, base)
 
 
 #: Sun angles below this are shaded as 0 without a word (Blender's default sun is 0.53 degrees).
@@ -55,6 +58,8 @@ def ignored_light_settings(obj, kind):
     """The settings of a light RT Lit does not shade (core/lights.py: radius-0 point and spot lights, an
     angle-0 sun, no exposure, temperature or spread), as short phrases: ["radius 0.1 m", ...]."""
     data = obj.data
+    kind = core_lights.base_kind(kind)
+    kind = "quad" if kind == "quad_spot" else kind
     out = []
     if abs(getattr(data, "exposure", 0.0)) > 0.0:
         out.append(f"exposure {data.exposure:+g}")
@@ -145,6 +150,8 @@ def sync_scene_lights(scene):
     ng.description = "Driver values of the scene's lights (rebuilt by RT Lookdev > Sync Lights)"
     plan = []
     for index, (obj, kind) in enumerate(records):
+        if core_lights.split_kind(kind)[1] or core_lights.base_kind(kind) == "quad_spot":
+            light_controls.store_driven_values(obj.data)
         for param, source in core_lights.driver_sources(kind, _shape(obj)).items():
             plan.append((light_input(index, param), obj, source,
                          Socket("float", 0.0, description=f"{obj.name}: {param} ({source[0]} {source[1]})",

@@ -56,9 +56,13 @@ axis_u x axis_v does.  Negative (mirroring) scales are not supported.
 """
 from __future__ import annotations
 
+import functools
+import math
+
 import numpy as np
 
 from . import shading_ops as op
+from . import falloff
 from .falloff import MIN_DISTANCE
 from .ir.functions import NodeFunction
 from .ir.interface import Socket, scalar, vector
@@ -354,23 +358,187 @@ SUN_LIGHT = NodeFunction(
     {"L": _L, "Irradiance": _IRRADIANCE},
     "An angle-0 Blender sun: direction to the sun (its +Z axis) and irradiance S color")
 
-NODE_FUNCTIONS = (AREA_LIGHT_QUAD, AREA_LIGHT_DISK, POINT_LIGHT, SPOT_LIGHT, SUN_LIGHT)
+# --- the talk's epilogue: light controls ---------------------------------------------------------------
+# "Control over performance: radius falloff, cone angle falloff; fall back to point lights: omni or spot light."
+# Area lights get a cone whose apex sits behind the light at the projector distance p = (d/2)/tan(phi/2) (d the
+# light's diameter, phi the outer angle), so that the cone fits around the light; the cone falloff is measured
+# at that apex, for the area light and for its spot fallback alike (the talk: "use cone apex for cone angle fall
+# off for spot and quad light").  The windowed range multiplies any light but the sun.
+
+def area_light_diameter(scale_x, scale_y, size, size_y, shape):
+    """Diameter of the circle around the light seen along its axis: a quad's diagonal, an ellipse's major axis."""
+    dx, dy = op.absolute(scale_x * size), op.absolute(scale_y * size_y)
+    if shape == "quad":
+        return op.sqrt(dx * dx + dy * dy)
+    return op.maximum(dx, dy)
+
+
+def projector_apex(location, w, x, y, z, scale_x, scale_y, size, size_y, outer_angle, shape):
+    """(apex, emission axis): the talk's projector point behind an area light, p = (d/2)/tan(phi/2) behind its
+    centre (``falloff.projector_distance``), and the unit direction the light emits along (its local -Z)."""
+    axis = op.scale(quat_rotate(w, x, y, z, _EZ), -1.0)
+    p = falloff.projector_distance(area_light_diameter(scale_x, scale_y, size, size_y, shape), outer_angle)
+    return location - op.scale(axis, p), axis
+
+
+def apex_cone_falloff(position, apex, axis, inner_angle, outer_angle):
+    """The talk's cone falloff at the projector apex for a shading point (``falloff.cone_falloff``)."""
+    return falloff.cone_falloff(op.dot(op.normalize(position - apex), axis), inner_angle, outer_angle)
+
+
+def range_falloff(position, location, radius):
+    """Karis 2013's window saturate(1 - (d/r)^4)^2 on the distance to the light's location."""
+    d = position - location
+    return falloff.window_falloff(op.sqrt(op.dot(d, d)), radius)
+
+
+def quad_spot_incidence(position, location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y,
+                        inner_angle, outer_angle):
+    """(l, E) of the quad-to-spot fallback: the quad's far field, a point at its centre of intensity
+    I(theta) = L A cos(theta) = P color cos(theta) / pi (a Lambertian emitter, theta from its axis), times the talk's
+    cone falloff at the projector apex behind the quad; E = I / max(d^2, d_min^2), d from the centre.
+
+    The talk's images show a spot at the apex, which emits the same intensity in every direction of its cone: it
+    misses the quad's cosine, by 29-89% (median) on a floor under the talk's angle pairs, and converges to nothing
+    with distance; a spot at the apex with the cosine converges as the apex offset over the distance (10% at one
+    light size, 1% at ten); at the centre it is the quad's far field, 2.5% at two light diameters, 0.3% at six
+    (docs/benchmarks/light_fallback.md)."""
+    apex, axis = projector_apex(location, w, x, y, z, scale_x, scale_y, size, size_y, outer_angle, "quad")
+    l, inv_d2 = _towards(position, location)
+    emission = op.maximum(-op.dot(l, axis), 0.0)
+    cone = apex_cone_falloff(position, apex, axis, inner_angle, outer_angle)
+    return l, op.scale(color, power * _INV_PI * inv_d2 * emission * cone)
+
+
+def _quad_spot_node(**kw):
+    l, e = quad_spot_incidence(kw["Position"], _loc(kw), *_rot(kw), *_scl(kw), kw["Power"], _col(kw), kw["Size"],
+                               kw["Size Y"], kw["Cone Inner"], kw["Cone Outer"])
+    return {"L": l, "Irradiance": e}
+
+
+def _cone_sockets():
+    return {"Cone Inner": scalar(math.radians(90.0), "Inner full cone angle theta at the projector apex (light data "
+                                 "rtl_cone_inner)", 0.0, math.pi, subtype="ANGLE", panel=_DATA_PANEL),
+            "Cone Outer": scalar(math.radians(100.0), "Outer full cone angle phi at the projector apex; the apex sits "
+                                 "(d/2)/tan(phi/2) behind the light (light data rtl_cone_outer)", 0.0, math.pi,
+                                 subtype="ANGLE", panel=_DATA_PANEL)}
+
+
+QUAD_SPOT_LIGHT = NodeFunction(
+    "RTL Quad Spot Fallback Light", _quad_spot_node,
+    {**_location_sockets(), **_rotation_sockets(), **_scale_sockets(), **_power_socket("Area light"),
+     **_color_sockets(), **_size_sockets("Quad"), **_cone_sockets(), **_POSITION},
+    {"L": _L, "Irradiance": _IRRADIANCE},
+    "The talk's quad-to-spot fallback: the quad's far field, P color cos / pi from its centre, with the cone falloff "
+    "at the projector apex")
+
+NODE_FUNCTIONS = (AREA_LIGHT_QUAD, AREA_LIGHT_DISK, POINT_LIGHT, SPOT_LIGHT, SUN_LIGHT, QUAD_SPOT_LIGHT)
 
 #: RT Lit light kind -> the node function that turns driver values into light geometry.
 LIGHT_DATA = {"quad": AREA_LIGHT_QUAD, "disk": AREA_LIGHT_DISK, "point": POINT_LIGHT, "spot": SPOT_LIGHT,
-              "sun": SUN_LIGHT}
+              "sun": SUN_LIGHT, "quad_spot": QUAD_SPOT_LIGHT}
+
+#: Build-time options of a light kind ("quad+range", "disk+cone+range"): each adds its falloff, and its driver
+#: inputs, to the light's data function (``light_data``); a light without them carries no node of them.
+LIGHT_OPTIONS = ("cone", "range")
+#: The base kinds each option applies to (quad_spot has its cone built in; the sun has no distance).
+OPTION_KINDS = {"cone": ("quad", "disk"), "range": ("quad", "disk", "point", "spot", "quad_spot")}
+_OPTION_SEPARATOR = "+"
+
+
+def split_kind(kind):
+    """("quad", ("cone", "range")) from "quad+cone+range"; ValueError for an unknown kind or option."""
+    base, *options = kind.split(_OPTION_SEPARATOR)
+    if base not in LIGHT_DATA:
+        raise ValueError(f"unknown light kind {base!r} (known: {', '.join(LIGHT_DATA)})")
+    for option in options:
+        if option not in LIGHT_OPTIONS or base not in OPTION_KINDS[option]:
+            raise ValueError(f"light kind {base!r} has no option {option!r}")
+    if list(options) != sorted(set(options), key=LIGHT_OPTIONS.index):
+        raise ValueError(f"{kind!r}: options must be unique and in the order {LIGHT_OPTIONS}")
+    return base, tuple(options)
+
+
+def base_kind(kind):
+    """The kind without its options: "quad" for "quad+range"."""
+    return split_kind(kind)[0]
+
+
+def kind_name(base, options=()):
+    """The kind string of a base kind with options (in ``LIGHT_OPTIONS`` order, the ones it has)."""
+    chosen = [o for o in LIGHT_OPTIONS if o in set(options) and base in OPTION_KINDS[o]]
+    return _OPTION_SEPARATOR.join([base] + chosen)
+
+
+def kind_identifier(kind):
+    """``kind`` as an identifier (shader uniform names): "quad_cone_range"."""
+    return kind.replace(_OPTION_SEPARATOR, "_")
+
+
+_RANGE_SOCKET = {"Range": scalar(10.0, "Range r of the windowed falloff saturate(1 - (d/r)^4)^2, d from the light's "
+                                       "location (light data rtl_range); r <= 0 turns the light off", 0.0, None,
+                                 subtype="DISTANCE", panel=_DATA_PANEL)}
+
+
+def control_factor(kind, position, params):
+    """The falloff the options of ``kind`` apply to the light's colour at ``position`` (1.0 without options);
+    ``params``: the light's driver values (``light_data(kind)``'s inputs)."""
+    base, options = split_kind(kind)
+    factor = 1.0
+    if "range" in options:
+        factor = range_falloff(position, _loc(params), params["Range"])
+    if "cone" in options:
+        apex, axis = projector_apex(_loc(params), *_rot(params), params["Scale X"], params["Scale Y"], params["Size"],
+                                    params["Size Y"], params["Cone Outer"], base)
+        factor = factor * apex_cone_falloff(position, apex, axis, params["Cone Inner"], params["Cone Outer"])
+    return factor
+
+
+def _with_options(base, options):
+    data = LIGHT_DATA[base]
+    color_name = "Radiance" if "Radiance" in data.output_sockets else "Irradiance"
+    kind = kind_name(base, options)
+
+    def body(**kw):
+        out = dict(data(**{k: kw[k] for k in data.input_sockets}))
+        out[color_name] = op.scale(out[color_name], control_factor(kind, kw["Position"], kw))
+        return out
+
+    inputs = dict(data.input_sockets)
+    inputs.pop("Position", None)
+    if "cone" in options:
+        inputs.update(_cone_sockets())
+    if "range" in options:
+        inputs.update(_RANGE_SOCKET)
+    inputs.update(_POSITION)
+    words = {"cone": "cone falloff at the projector apex", "range": "windowed range"}
+    return NodeFunction(f"{data.name} ({', '.join(options)})", body, inputs, dict(data.output_sockets),
+                        f"{data.description}; with the talk's " + " and ".join(words[o] for o in options))
+
+
+@functools.lru_cache(maxsize=None)
+def light_data(kind):
+    """The data function of a light kind with its options (``LIGHT_DATA[kind]`` for a kind without)."""
+    base, options = split_kind(kind)
+    return LIGHT_DATA[base] if not options else _with_options(base, options)
+
+
+#: The data functions of one light of each kind with every option it takes (what tests check in each backend).
+CONTROL_FUNCTIONS = tuple(light_data(kind_name(k, LIGHT_OPTIONS)) for k in ("quad", "disk", "point", "spot", "quad_spot"))
 
 _DATA_PATHS = {"Power": "energy", "Strength": "energy", "Color R": "color[0]", "Color G": "color[1]",
                "Color B": "color[2]", "Size": "size", "Size Y": "size_y", "Spot Size": "spot_size",
-               "Spot Blend": "spot_blend"}
+               "Spot Blend": "spot_blend",
+               # the light controls: custom properties of the light data (addon/light_controls.py registers them)
+               "Range": '["rtl_range"]', "Cone Inner": '["rtl_cone_inner"]', "Cone Outer": '["rtl_cone_outer"]'}
 
 
 def driver_sources(kind, shape=None):
-    """Where each input of ``LIGHT_DATA[kind]`` comes from in Blender, as the driver that feeds it:
+    """Where each input of ``light_data(kind)`` comes from in Blender, as the driver that feeds it:
     ("transform", TRANSFORMS channel in world space) or ("data", light data path).  SQUARE and DISK
     lights have one size: their "Size Y" reads ``size`` too (Cycles ignores size_y for them)."""
     out = {}
-    for name in LIGHT_DATA[kind].input_sockets:
+    for name in light_data(kind).input_sockets:
         if name == "Position":
             continue
         word, _, axis = name.partition(" ")

@@ -320,6 +320,12 @@ def light_data_inputs(function, size=SIZE, seed=17):
             vals[name] = rng.uniform(0.0, np.pi, shape)
         elif name in ("Spot Blend",) or name.startswith("Color"):
             vals[name] = rng.random(shape)
+        elif name in ("Cone Inner", "Cone Outer"):           # the light controls (core/lights.py light_data)
+            vals[name] = rng.uniform(0.0, np.pi, shape)
+            vals[name].reshape(-1)[:2] = (0.0, np.pi)
+        elif name == "Range":
+            vals[name] = rng.uniform(0.0, 8.0, shape)
+            vals[name].reshape(-1)[:1] = 0.0
         else:                                  # Power, Strength, Size, Size Y
             vals[name] = rng.uniform(0.0, 5.0, shape) * (100.0 if name == "Power" else 1.0)
         if name in ("Size", "Size Y", "Power", "Scale X"):
@@ -342,7 +348,7 @@ def material_inputs(material, size=SIZE, seed=21):
     flip = np.einsum("...i,...i->...", n, vals["Incoming"]) < 0
     vals["Incoming"][flip & (rng.random(shape) < 0.9)] *= -1
     for kind, names in zip(material.light_kinds, material.light_inputs):
-        drivers = light_data_inputs(lights.LIGHT_DATA[kind], size=size, seed=int(rng.integers(1 << 30)))
+        drivers = light_data_inputs(lights.light_data(kind), size=size, seed=int(rng.integers(1 << 30)))
         for param, name in names.items():
             value = drivers[param]
             if param.startswith("Location"):          # lights outside the unit sphere

@@ -111,7 +111,8 @@ def light_kinds(count):
         return ("quad",)
     if count == 4:
         return ("quad", "disk", "point", "spot")
-    return tuple(LIGHT_KINDS[k % len(LIGHT_KINDS)] for k in range(count))
+    kinds = tuple(k for k in LIGHT_KINDS if k != "quad_spot")      # the Blender light types, no fallback
+    return tuple(kinds[k % len(kinds)] for k in range(count))
 
 
 def write_scene(folder, features, world, count, resolution, lut_dir):

@@ -153,13 +153,16 @@ class LightSpec:
     color: tuple = WHITE
     spot_size: float = 0.9
     spot_blend: float = 0.3
+    #: RT Lookdev's light controls (addon/light_controls.py): custom property -> value, e.g. {"rtl_use_range": True}
+    controls: dict = field(default_factory=dict)
 
     def describe(self):
         x, y, z = self.location
         s = f"{self.kind} at ({x:.2f}, {y:.2f}, {z:.2f})"
         if self.kind in ("quad", "disk"):
             s += f" size {self.size:.2f}" + (f" x {self.size_y:.2f}" if self.size_y else "")
-        return s + f", energy {self.energy:g}"
+        on = [k[len("rtl_"):] for k, v in self.controls.items() if v is True]
+        return s + f", energy {self.energy:g}" + (f", {'/'.join(on)}" if on else "")
 
 
 @dataclass
@@ -345,6 +348,8 @@ def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
                 data.spot_size, data.spot_blend = spec.spot_size, spec.spot_blend
         else:
             data.angle = 0.0
+        for key, value in spec.controls.items():
+            data[key] = value
         obj = bpy.data.objects.new(f"L{i}_{spec.kind}", data)
         obj.location = spec.location
         obj.visible_camera = False
@@ -589,9 +594,11 @@ def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
 # --- (c) brute-force ground truth -------------------------------------------------------------
 
 def _area_geometry(kind, params):
+    """The area light's geometry and radiance (without its options' falloff: ``core.lights.control_factor``)."""
     from ..core import lights as core_lights
 
-    out = core_lights.LIGHT_DATA[kind](**{k: np.float64(v) for k, v in params.items()})
+    data = core_lights.LIGHT_DATA[core_lights.base_kind(kind)]
+    out = data(**{k: np.float64(v) for k, v in params.items() if k in data.input_sockets})
     out = {k: np.asarray(v, np.float64) for k, v in out.items()}
     if kind == "quad":
         return {"corners": np.stack([out[f"p{i}"] for i in range(4)]), "radiance": out["Radiance"]}
@@ -661,8 +668,11 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
         surface = _surface(features, material, N, V)
         sums = np.zeros((len(levels), len(ys), 3))
         for kind, params in lights:
-            if kind in ("quad", "disk"):
+            if core_lights.base_kind(kind) in ("quad", "disk"):
                 geo = _area_geometry(kind, params)
+                # the options' falloff is constant over the light for one shading point
+                control = np.broadcast_to(np.asarray(core_lights.control_factor(
+                    kind, P, {k: np.float64(v) for k, v in params.items()}), np.float64), (len(ys),))
                 for lev, level in enumerate(levels):
                     for start in range(0, len(ys), chunk):
                         owner, dirs, irr = [], [], []
@@ -674,7 +684,7 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
                             r = np.linalg.norm(xr, axis=-1)
                             owner.append(np.full(len(w), k))
                             dirs.append(xr / r[:, None])
-                            irr.append((w * np.abs(xr @ ln) / r ** 3)[:, None] * geo["radiance"])
+                            irr.append((w * np.abs(xr @ ln) / r ** 3)[:, None] * geo["radiance"] * control[k])
                         if owner:
                             owner = np.concatenate(owner)
                             rad = _shade(shade, surface, owner, np.concatenate(dirs), np.concatenate(irr))
@@ -683,9 +693,9 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
             else:
                 # punctual: the true BRDF at the one light direction (no integral)
                 args = {k: np.full(len(ys), v, np.float64) for k, v in params.items()}
-                if "Position" in core_lights.LIGHT_DATA[kind].input_sockets:
+                if "Position" in core_lights.light_data(kind).input_sockets:
                     args["Position"] = P
-                light = core_lights.LIGHT_DATA[kind](**args)
+                light = core_lights.light_data(kind)(**args)
                 L = np.broadcast_to(np.asarray(light["L"], np.float64), P.shape)
                 E = np.broadcast_to(np.asarray(light["Irradiance"], np.float64), P.shape)
                 sums += _shade(shade, surface, np.arange(len(ys)), L, E)[None]

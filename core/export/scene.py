@@ -311,6 +311,7 @@ def read(folder):
     if data.get("version") != VERSION:
         raise SceneDescriptionError(f"{path}: version {data.get('version')} is not supported (this reader reads "
                                     f"version {VERSION}); export the scene again")
+    from ..lights import split_kind
     from ..materials.rt_lit_interface import LIGHT_KINDS
 
     try:
@@ -324,9 +325,11 @@ def read(folder):
         raise SceneDescriptionError(f"{path}: malformed ({type(exc).__name__}: {exc})") from None
     camera.validate(path)
     for light in lights:
-        if light.kind not in LIGHT_KINDS:
+        try:
+            split_kind(light.kind)
+        except ValueError as exc:
             raise SceneDescriptionError(f"{path}: light {light.name!r} is of kind {light.kind!r}; RT Lit shades "
-                                        f"{LIGHT_KINDS}")
+                                        f"{LIGHT_KINDS} ({exc})") from None
     for obj in objects:
         if obj.material not in materials:
             raise SceneDescriptionError(f"{path}: object {obj.name!r} uses material {obj.material!r}, which is not "

@@ -86,7 +86,7 @@ def parse_args(argv):
     p.add_argument("--diffuse", default="cod", choices=DIFFUSE_MODELS)
     p.add_argument("--sheen", action="store_true")
     p.add_argument("--cloth", action="store_true")
-    p.add_argument("--lights", default="quad,disk", help=f"light kinds in order, from {', '.join(LIGHT_KINDS)}")
+    p.add_argument("--lights", default="quad,disk", help=f"light kinds in order, from {', '.join(LIGHT_KINDS)}; options as quad+cone+range")
     p.add_argument("--dialects", default=",".join(EXTENSIONS))
     p.add_argument("--world", type=Path, default=None, help="a prefiltered environment EXR (a world bake)")
     p.add_argument("--world-table", default=None, help="its table name (default: the file's stem)")
@@ -101,10 +101,18 @@ def run_args(args, log=print):
     from ..materials.rt_lit_interface import LIGHT_KINDS, Features
     from ..materials.world_shading import WorldEnvironment
 
+    from ..lights import LIGHT_OPTIONS, split_kind
+
     kinds = tuple(k for k in args.lights.split(",") if k)
-    bad = [k for k in kinds if k not in LIGHT_KINDS]
+    bad = []
+    for k in kinds:
+        try:
+            split_kind(k)
+        except ValueError:
+            bad.append(k)
     if bad:
-        print(f"export_shader: unknown light kinds {bad}; choose from {', '.join(LIGHT_KINDS)}", file=sys.stderr)
+        print(f"export_shader: unknown light kinds {bad}; choose from {', '.join(LIGHT_KINDS)}, with options "
+              f"+{' +'.join(LIGHT_OPTIONS)} (quad+cone+range)", file=sys.stderr)
         return 2
     env = WorldEnvironment.load(args.world, args.world_table or args.world.stem) if args.world else None
     material = rt_lit.build_rt_lit(Features(args.specular, args.diffuse, args.sheen, args.cloth), kinds, env)

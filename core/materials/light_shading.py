@@ -119,7 +119,7 @@ def shade_surface(features):
 
 def light_color_name(kind):
     """"Radiance" for area lights, "Irradiance" for punctual lights (the light data's colour output)."""
-    return "Radiance" if "Radiance" in lights.LIGHT_DATA[kind].output_sockets else "Irradiance"
+    return "Radiance" if "Radiance" in lights.LIGHT_DATA[lights.base_kind(kind)].output_sockets else "Irradiance"
 
 
 def _arguments(fn, available):
@@ -128,7 +128,8 @@ def _arguments(fn, available):
 
 @functools.lru_cache(maxsize=None)
 def shade_function(kind, features):
-    """``RTL Shade <Kind> (<features>)``: one light's radiance towards the viewer."""
+    """``RTL Shade <Kind> (<features>)``: one light's radiance towards the viewer (``kind`` a base kind: its
+    options change the light's data, not its shading)."""
     color_name = light_color_name(kind)
     functions = [lobes.LOBES[key].function(kind) for key in lobe_keys(features)]
 
@@ -140,14 +141,15 @@ def shade_function(kind, features):
 
     surface_terms = shade_surface(features)
     inputs = {k: SURFACE_OUTPUTS[k] for k in surface_terms}
-    if kind in lobes.AREA_KINDS + ("point", "spot"):
+    if kind in lobes.AREA_KINDS + ("point", "spot", "quad_spot"):
         inputs["Position"] = GEOMETRY_INPUTS["Position"]
     inputs.update(lobes.light_geometry_sockets(kind))
     inputs[color_name] = lights.LIGHT_DATA[kind].output_sockets[color_name]
     # only the inputs some lobe or the combination reads
     used = set(surface_terms) | {color_name}.union(*(fn.input_sockets for fn in functions))
     inputs = {k: v for k, v in inputs.items() if k in used}
-    title = kind.capitalize() if kind not in lobes.AREA_KINDS else f"{kind.capitalize()} Area"
+    title = {"quad_spot": "Quad Spot Fallback"}.get(kind, kind.capitalize())
+    title = title if kind not in lobes.AREA_KINDS else f"{title} Area"
     return NodeFunction(f"RTL Shade {title} ({features.label()})", shade, inputs,
                         {"Radiance": color((0.0, 0.0, 0.0), "Radiance towards the viewer from this light")},
                         f"One {kind} light on the RT Lit material ({features.label()})", tables=REFERENCES)
@@ -156,6 +158,6 @@ def shade_function(kind, features):
 def shade_light(tables, kind, features, surface, position, light):
     """Radiance from one light: ``surface`` the "RTL Surface" outputs, ``light`` the outputs of the
     light's data function (``core.lights.LIGHT_DATA``); arrays (``tables`` with data) or Exprs."""
-    fn = shade_function(kind, features)
+    fn = shade_function(lights.base_kind(kind), features)
     available = dict(surface, Position=position, **light)
     return fn(tables, **_arguments(fn, available))["Radiance"]

@@ -31,7 +31,8 @@ from ..lut.lookup import REFERENCES
 from ..ltc import shading
 
 AREA_KINDS = ("quad", "disk")
-PUNCTUAL_KINDS = ("point", "spot", "sun")
+#: quad_spot: the talk's quad-to-spot fallback, shaded as a spot light (core/lights.py).
+PUNCTUAL_KINDS = ("point", "spot", "sun", "quad_spot")
 
 _N = vector("Shading normal, unit, world space", "NONE", hide_value=True)
 _V = vector("Unit direction towards the viewer", "NONE", hide_value=True)
@@ -62,8 +63,10 @@ class Lobe:
     reads_tables_punctual: bool = field(default=False)
 
     def function(self, kind):
-        """The node function of this lobe for a light kind (cached; one for all punctual kinds)."""
-        return _lobe_function(self.key, "punctual" if kind in PUNCTUAL_KINDS else kind)
+        """The node function of this lobe for a light kind (cached; one for all punctual kinds; a kind's options
+        change the light's data, not its lobes)."""
+        base = lights.base_kind(kind)
+        return _lobe_function(self.key, "punctual" if base in PUNCTUAL_KINDS else base)
 
 
 def punctual_cosines(n, v, l):
@@ -248,7 +251,7 @@ def _area_light(kind, kw):
 
 def light_geometry_sockets(kind):
     """The geometry outputs of the light's data function (all but its radiance or irradiance)."""
-    data = lights.LIGHT_DATA[kind]
+    data = lights.LIGHT_DATA[lights.base_kind(kind)]
     return {n: s for n, s in data.output_sockets.items() if n not in ("Radiance", "Irradiance")}
 
 

@@ -43,7 +43,7 @@ from .surface import SURFACE
 
 def light_parameters(kind):
     """The driver parameters of one light of ``kind`` ("Location X", ..., "Power", ...), in order."""
-    return [n for n in lights.LIGHT_DATA[kind].input_sockets if n != "Position"]
+    return [n for n in lights.light_data(kind).input_sockets if n != "Position"]
 
 
 def compose(tables, features, material, geometry, lights_in_scene, world=None):
@@ -58,7 +58,7 @@ def compose(tables, features, material, geometry, lights_in_scene, world=None):
                       **{k: geometry[k] for k in ("Geometry Normal", "Incoming")})
     parts = [surface["Emission"]]
     for kind, params in lights_in_scene:
-        data_fn = lights.LIGHT_DATA[kind]
+        data_fn = lights.light_data(kind)
         args = dict(params)
         if "Position" in data_fn.input_sockets:
             args["Position"] = geometry["Position"]
@@ -138,13 +138,15 @@ def _function_inputs(light_kinds, environment):
         sockets[name] = sock
     per_light = []
     for index, kind in enumerate(light_kinds):
-        if kind not in LIGHT_KINDS:
-            raise ValueError(f"unknown light kind {kind!r}; RT Lit shades {LIGHT_KINDS}")
+        try:
+            lights.split_kind(kind)
+        except ValueError as exc:
+            raise ValueError(f"unknown light kind {kind!r}; RT Lit shades {LIGHT_KINDS} ({exc})") from None
         names = {}
         for param in light_parameters(kind):
             names[param] = light_input(index, param)
             kinds[names[param]] = FLOAT
-            sockets[names[param]] = lights.LIGHT_DATA[kind].input_sockets[param]
+            sockets[names[param]] = lights.light_data(kind).input_sockets[param]
         per_light.append(names)
     world = {}
     if environment is not None:

@@ -83,8 +83,9 @@ RT_LIT_GROUP_PREFIX = "RT Lit"
 RADIANCE_OUTPUT = "Radiance"
 EMISSION_OUTPUT = "Material Emission"
 WORLD_OUTPUT = "World Radiance"
-#: The light kinds RT Lit shades (area quad and disk, point, spot, sun: core/lights.py).
-LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun")
+#: The light kinds RT Lit shades (area quad and disk, point, spot, sun, and the talk's quad-to-spot fallback:
+#: core/lights.py).  A kind may carry build-time options, "quad+cone+range" (``core.lights.split_kind``).
+LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad_spot")
 
 
 def light_input(index, parameter):

@@ -46,22 +46,29 @@ _VECTOR_FIELDS = {
     "Scale": ("scale", "vec3", "XYZ"),
     "Color": ("color", "vec3", "RGB"),
 }
-#: The struct of each light kind and its uniform array.
+#: The struct of each base light kind (a kind with options gets its own: ``light_struct``) and its uniform array.
 LIGHT_STRUCTS = {"quad": "RtlAreaLight", "disk": "RtlAreaLight", "point": "RtlPointLight", "spot": "RtlSpotLight",
-                 "sun": "RtlSunLight"}
+                 "sun": "RtlSunLight", "quad_spot": "RtlQuadSpotLight"}
 _WORLD_SH = 9
 
 
 def light_array(kind):
-    """The uniform array of lights of ``kind``: "u_quad_lights"."""
-    return f"u_{kind}_lights"
+    """The uniform array of lights of ``kind``: "u_quad_lights", "u_quad_cone_range_lights"."""
+    return f"u_{lights.kind_identifier(kind)}_lights"
+
+
+def light_struct(kind):
+    """The struct of ``kind``'s lights: its base kind's, with the options' names for a kind with options
+    ("RtlAreaLightConeRange": its fields are the base's plus the options' parameters)."""
+    base, options = lights.split_kind(kind)
+    return LIGHT_STRUCTS[base] + "".join(o.capitalize() for o in options)
 
 
 def light_fields(kind):
     """[(field, type, [(parameter, component)])] of the struct of ``kind``, from its driver parameters
-    (core/lights.py ``LIGHT_DATA``); component None for a scalar field."""
+    (core/lights.py ``light_data``); component None for a scalar field."""
     fields, seen = [], {}
-    for param in lights.LIGHT_DATA[kind].input_sockets:
+    for param in lights.light_data(kind).input_sockets:
         if param == "Position":
             continue
         word, _, axis = param.partition(" ")
@@ -183,12 +190,12 @@ class _Interface:
         if counts:
             self.lines.append("// Lights, Blender's units: location m, rotation the unit quaternion (x, y, z, w) of the "
                               "object's world rotation, world scale, power W (sun: strength W/m^2), sizes m, spot size rad")
-        for struct in dict.fromkeys(LIGHT_STRUCTS[k] for k in counts):
-            kind = next(k for k in counts if LIGHT_STRUCTS[k] == struct)
+        for struct in dict.fromkeys(light_struct(k) for k in counts):
+            kind = next(k for k in counts if light_struct(k) == struct)
             members = " ".join(f"{self.types[typ]} {field};" for field, typ, _ in light_fields(kind))
             self.lines.append(f"struct {struct} {{ {members} }};")
         for kind, count in counts.items():
-            self.declare(light_array(kind), LIGHT_STRUCTS[kind],
+            self.declare(light_array(kind), light_struct(kind),
                          f"the scene's {kind} lights, in the material's light order", count)
         for (kind, index), names in zip(self.slots, self.material.light_inputs):
             for field, _, parts in light_fields(kind):
@@ -306,7 +313,7 @@ def material_shader(material, dialect="glsl450", precise=True):
     "glsl300es", "hlsl"); ``precise`` as ``shader_text.emit``."""
     if dialect not in shader_text.DIALECTS:
         raise ValueError(f"unknown shader dialect {dialect!r}; choose one of {sorted(shader_text.DIALECTS)}")
-    unknown = [k for k in material.light_kinds if k not in LIGHT_KINDS]
+    unknown = [k for k in material.light_kinds if lights.base_kind(k) not in LIGHT_KINDS]
     if unknown:
         raise ValueError(f"{material.name}: light kinds {unknown} have no shader form (RT Lit shades {LIGHT_KINDS})")
     module = shader_text.emit(material.function, dialect, precise)

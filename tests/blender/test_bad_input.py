@@ -237,6 +237,10 @@ def test_lights_stay_in_sync_without_a_button(registered, empty_scene, lut_dir):
     assert update() == ["point", "quad"]                    # "Key", "Panel" in name order
     area.data.shape = "DISK"
     assert update() == ["point", "disk"]
+    area.data.rtl_use_cone = True                           # a light control changes the light's kind
+    assert update() == ["point", "disk+cone"]
+    area.data.rtl_use_cone = False
+    assert update() == ["point", "disk"]
     key.hide_render = True
     assert update() == ["disk"]
     key.hide_render = False

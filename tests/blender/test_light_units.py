@@ -302,7 +302,7 @@ def _node_inputs(fn, rng):
     q = rng.normal(size=(n, 4))
     q /= np.linalg.norm(q, axis=-1, keepdims=True)
     ranges = {"Location": (-3, 3), "Scale": (0.2, 3), "Color": (0, 1), "Power": (1, 2000), "Strength": (0, 10),
-              "Size": (0.01, 4), "Spot Size": (0.1, 3.1), "Spot Blend": (0, 1)}
+              "Size": (0.01, 4), "Spot Size": (0.1, 3.1), "Spot Blend": (0, 1), "Cone": (0.1, 3.1), "Range": (0.0, 8.0)}
     values = {}
     for name in fn.input_sockets:
         if name.startswith("Rotation "):
@@ -336,7 +336,7 @@ def _vector_wrapper(bpy, inner):
     return ng
 
 
-@pytest.mark.parametrize("fn", lights.NODE_FUNCTIONS, ids=lambda f: f.name)
+@pytest.mark.parametrize("fn", lights.NODE_FUNCTIONS + lights.CONTROL_FUNCTIONS, ids=lambda f: f.name)
 def test_node_group_renders_like_numpy(empty_scene, bpy_module, fn):
     """Each light function, emitted as its node group, gives the numpy backend's values in Cycles."""
     from rt_lookdev.validation.conformance import render_group_outputs

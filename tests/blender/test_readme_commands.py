@@ -41,6 +41,7 @@ RUN_BY = {
     "scripts/benchmark_rt_lit.py": "here",
     "scripts/build_presets.py": "here",
     "scripts/benchmark_wrapped_diffuse.py": "here",
+    "scripts/benchmark_light_fallback.py": "here",
 }
 
 #: The commands run here: (script, arguments, files it must write under the output folder).
@@ -55,6 +56,7 @@ SMOKE = {
     "scripts/build_presets.py": (["--out", "{out}"], ["rt_lookdev_presets.blend", "blender_assets.cats.txt"]),
     "scripts/benchmark_wrapped_diffuse.py": (["--quick", "--lights", "4", "--out", "{out}"],
                                              ["wrapped_diffuse.md", "wrapped_diffuse.json"]),
+    "scripts/benchmark_light_fallback.py": (["--quick", "--out", "{out}"], ["light_fallback.md", "light_fallback.json"]),
 }
 
 

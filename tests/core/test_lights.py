@@ -53,6 +53,10 @@ def _random_inputs(fn, rng, n=N):
             values[name] = rng.uniform(0.05, np.pi, n)
         elif name == "Spot Blend":
             values[name] = rng.uniform(0, 1, n)
+        elif name in ("Cone Inner", "Cone Outer"):
+            values[name] = rng.uniform(0.05, np.pi, n)
+        elif name == "Range":
+            values[name] = rng.uniform(0.0, 8.0, n)
         elif name in ("Size", "Size Y"):
             values[name] = rng.uniform(0.01, 4, n)
         else:                                   # Power, Strength
@@ -60,7 +64,10 @@ def _random_inputs(fn, rng, n=N):
     return values
 
 
-@pytest.mark.parametrize("fn", lights.NODE_FUNCTIONS, ids=lambda f: f.name)
+ALL_DATA = lights.NODE_FUNCTIONS + lights.CONTROL_FUNCTIONS
+
+
+@pytest.mark.parametrize("fn", ALL_DATA, ids=lambda f: f.name)
 def test_numpy_and_traced_ir_agree(fn):
     rng = np.random.default_rng(7)
     values = _random_inputs(fn, rng)
@@ -74,7 +81,7 @@ def test_numpy_and_traced_ir_agree(fn):
         np.testing.assert_allclose(got, ref, rtol=1e-6, atol=1e-6 * scale, err_msg=f"{fn.name}: {name}")
 
 
-@pytest.mark.parametrize("fn", lights.NODE_FUNCTIONS, ids=lambda f: f.name)
+@pytest.mark.parametrize("fn", ALL_DATA, ids=lambda f: f.name)
 def test_call_node_and_interface(fn):
     """A call from another graph gives the body's values; sockets are as documented; <= 140 nodes."""
     kinds = fn.input_kinds
@@ -109,6 +116,9 @@ def test_interfaces_are_the_driver_values():
         "RTL Spot Light": (loc + rot + scl + ["Power"] + col + ["Spot Size", "Spot Blend", "Position"],
                            ["L", "Irradiance"]),
         "RTL Sun Light": (rot + ["Strength"] + col, ["L", "Irradiance"]),
+        "RTL Quad Spot Fallback Light": (loc + rot + scl + ["Power"] + col + ["Size", "Size Y", "Cone Inner",
+                                                                            "Cone Outer", "Position"],
+                                         ["L", "Irradiance"]),
     }
     assert {f.name for f in lights.NODE_FUNCTIONS} == set(expect)
     for f in lights.NODE_FUNCTIONS:
@@ -287,7 +297,7 @@ def test_sun_direction_is_local_z():
     np.testing.assert_allclose(e, 3.0 * color)
 
 
-@pytest.mark.parametrize("fn", lights.NODE_FUNCTIONS, ids=lambda f: f.name)
+@pytest.mark.parametrize("fn", ALL_DATA, ids=lambda f: f.name)
 def test_float32_extremes_are_finite(fn):
     """Zero everything, then huge and tiny values: no NaN or Inf in either backend."""
     body = fn.function
@@ -300,3 +310,75 @@ def test_float32_extremes_are_finite(fn):
         with np.errstate(all="ignore"):
             for value in fn(**v).values():
                 assert np.isfinite(value).all(), (fn.name, fill)
+
+
+# --- the talk's light controls (issue 17, item 4) --------------------------------------------------------------
+
+def test_kinds_carry_their_options_in_one_order():
+    assert lights.split_kind("quad+cone+range") == ("quad", ("cone", "range"))
+    assert lights.kind_name("quad", ("range", "cone")) == "quad+cone+range"
+    assert lights.kind_name("sun", ("range",)) == "sun"                     # options a kind does not take drop
+    assert lights.kind_name("quad_spot", ("cone", "range")) == "quad_spot+range"
+    for bad in ("quad+range+cone", "sun+range", "point+cone", "quad+range+range", "lamp"):
+        with pytest.raises(ValueError):
+            lights.split_kind(bad)
+    assert lights.light_data("quad") is lights.AREA_LIGHT_QUAD
+    assert {"Cone Inner", "Cone Outer", "Range", "Position"} <= set(lights.light_data("quad+cone+range").input_sockets)
+    assert lights.driver_sources("quad+range", "SQUARE")["Range"] == ("data", '["rtl_range"]')
+
+
+def _quad_params(height=3.0, outer=100.0, inner=90.0, size=1.0, size_y=0.6):
+    return {"Location X": 0.0, "Location Y": 0.0, "Location Z": height, "Rotation W": 1.0, "Rotation X": 0.0,
+            "Rotation Y": 0.0, "Rotation Z": 0.0, "Scale X": 1.0, "Scale Y": 1.0, "Scale Z": 1.0, "Power": 100.0,
+            "Color R": 1.0, "Color G": 1.0, "Color B": 1.0, "Size": size, "Size Y": size_y,
+            "Cone Inner": math.radians(inner), "Cone Outer": math.radians(outer), "Range": 0.0}
+
+
+def test_the_projector_apex_sits_behind_the_light_so_the_cone_fits_around_it():
+    p = _quad_params()
+    loc = np.array([0.0, 0.0, 3.0])
+    apex, axis = lights.projector_apex(loc, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 0.6, math.radians(100.0), "quad")
+    np.testing.assert_allclose(axis, [0.0, 0.0, -1.0], atol=1e-12)            # a light emits along its -Z
+    diagonal = math.hypot(1.0, 0.6)
+    assert apex[2] - 3.0 == pytest.approx(0.5 * diagonal / math.tan(math.radians(50.0)))
+    # the quad's corners lie on the outer cone: the cone fits around the light
+    corner = np.array([0.5, 0.3, 3.0])
+    cos_corner = np.dot(_unit(corner - apex), axis)
+    assert cos_corner == pytest.approx(math.cos(math.radians(50.0)))
+    factor = lights.control_factor("quad+cone", np.array([[0.0, 0.0, 0.0], [0.0, 5.0, 2.9]]), p)
+    np.testing.assert_allclose(factor, [1.0, 0.0])                             # on the axis / outside the cone
+
+
+def _unit(v):
+    return v / np.linalg.norm(v)
+
+
+def test_range_window_reaches_zero_at_the_range():
+    p = dict(_quad_params(), Range=4.0)
+    pos = np.array([[0.0, 0.0, 3.0 - d] for d in (0.0, 2.0, 3.99, 4.0, 6.0)])
+    f = lights.control_factor("quad+range", pos, p)
+    np.testing.assert_allclose(f, [1.0, (1 - (2 / 4) ** 4) ** 2, (1 - (3.99 / 4) ** 4) ** 2, 0.0, 0.0], atol=1e-12)
+
+
+def test_the_fallback_is_the_quads_far_field():
+    """The quad-to-spot fallback is a point at the quad's centre of the quad's Lambertian intensity P cos / pi: far
+    away (100 light sizes) its irradiance is the quad's exact form factor, cone falloff included identically."""
+    from rt_lookdev.core.ltc import polygon
+
+    rng = np.random.default_rng(5)
+    p = _quad_params(outer=150.0, inner=140.0)
+    dirs = rng.normal(size=(64, 3))
+    dirs[:, 2] = -np.abs(dirs[:, 2]) - 0.6
+    pos = np.array([0.0, 0.0, 3.0]) + 100.0 * dirs / np.linalg.norm(dirs, axis=-1, keepdims=True)
+    spot = lights.light_data("quad_spot")(**{k: v for k, v in p.items() if k != "Range"}, Position=pos)
+    quad = lights.AREA_LIGHT_QUAD(**{k: v for k, v in p.items() if k in lights.AREA_LIGHT_QUAD.input_sockets})
+    corners = np.stack([quad[f"p{i}"] for i in range(4)])
+    cone = lights.control_factor("quad+cone", pos, p)
+    for k in range(len(pos)):
+        normal = spot["L"][k]                                  # a surface facing the light's centre
+        rel = corners - pos[k]
+        frame = polygon.local_frame(normal, _unit(normal + np.array([0.3, -0.2, 0.1])))
+        local = np.stack([polygon.frame_coordinates(frame, q) for q in rel])
+        form_factor = polygon.ltc_polygon_integral(np.eye(3), local, two_sided=True, method="clipped")
+        irradiance_quad = np.pi * form_factor * quad["Radiance"][0] * cone[k]
+        assert spot["Irradiance"][k][0] == pytest.approx(irradiance_quad, rel=2e-3, abs=1e-12)
