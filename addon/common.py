@@ -24,6 +24,10 @@ LIGHTS_RECORD_KEY = "rtl_lights"
 #: Custom property of ``SCENE_LIGHTS_GROUP``: the synced lights' "<object>:<kind>:<shape>", what the
 #: automatic light sync compares (addon/light_sync.py).
 LIGHTS_SIGNATURE_KEY = "rtl_light_signature"
+#: On a culled RT Lit group: the indices of the scene lights it shades (addon/materials.py ``cull_lights``).
+LIGHTS_SUBSET_KEY = "rtl_lights_subset"
+#: On "RTL Scene Lights": the lights that reach each RT Lit material, as last culled.
+REACH_KEY = "rtl_light_reach"
 #: Custom property of an emitted group: emitter version and structure hash (rebuilt when it changes).
 STAMP_KEY = "rtl_stamp"
 #: Name of the RT Lit group node inside a converted material.
@@ -40,7 +44,8 @@ ADDED_OUTPUT_KEY = "rtl_added_output"
 SAVED_EMISSION_SAMPLING_KEY = "rtl_saved_emission_sampling"
 
 __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WORLD_GROUP", "FEATURES_KEY",
-           "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "LIGHTS_SIGNATURE_KEY", "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
+           "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "LIGHTS_SIGNATURE_KEY", "LIGHTS_SUBSET_KEY", "REACH_KEY",
+           "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
            "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "connect_engine_outputs",
            "restore_engine_outputs", "not_a_light", "restore_emission_sampling",
            "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver"]

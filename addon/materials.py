@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 
 import bpy
+import mathutils
 
 from ..core import lights as core_lights
 from ..core.ir.expr import FLOAT, table_filter
@@ -27,8 +28,8 @@ from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, RT_LIT_OUTPUTS,
                                                Features, light_input, rt_lit_group_name)
 from . import compat, light_controls, node_emit, world_sync
-from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LIGHTS_SIGNATURE_KEY, RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME,
-                     SCENE_LIGHTS_GROUP, STAMP_KEY,
+from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LIGHTS_SIGNATURE_KEY, LIGHTS_SUBSET_KEY, REACH_KEY,
+                     RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP, STAMP_KEY,
                      WORLD_GROUP, add_driver, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers,
                      socket_by_identifier)
 
@@ -185,7 +186,11 @@ def lights_out_of_sync(scene):
         return False
     ng = bpy.data.node_groups.get(SCENE_LIGHTS_GROUP)
     synced = list(ng.get(LIGHTS_SIGNATURE_KEY, [])) if ng is not None else []
-    return light_signature(scene_lights(scene)) != synced
+    records = scene_lights(scene)
+    if light_signature(records) != synced:
+        return True
+    # a light with a range or an object that moved can change which lights reach a material (``cull_lights``)
+    return ng is not None and _reach_record(material_reach(scene, records)) != ng.get(REACH_KEY, _reach_record({}))
 
 
 def synced_light_kinds():
@@ -247,36 +252,47 @@ def engine_output(engine, output="Shader"):
     return next(prefix for name, _, _, prefix in ENGINE_TREES if name == engine) + output
 
 
-def ensure_rt_lit_group(features=None, scene=None, lut_dir=None):
+def culled_group_name(features, lights):
+    """"RT Lit (<features>) [lights 0, 2]": the RT Lit group of a material that only some lights reach."""
+    return f"{rt_lit_group_name(features)} [lights {', '.join(str(i) for i in lights)}]"
+
+
+def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
     """The RT Lit group for ``features`` and the lights of ``scene`` (built or reused): the material
     inputs as its interface, one nested tree per engine (``ENGINE_TREES``) fed by them, and each tree's
-    outputs ("Shader", "Radiance" for Cycles; "EEVEE Shader", "EEVEE Radiance")."""
+    outputs ("Shader", "Radiance" for Cycles; "EEVEE Shader", "EEVEE Radiance").  ``lights``: the indices
+    of the scene's lights it shades (``cull_lights``), default all of them."""
     features = features or Features()
     scene = scene or bpy.context.scene
     if bpy.data.node_groups.get(SCENE_LIGHTS_GROUP) is None:
         sync_scene_lights(scene)
     records = synced_light_kinds()
+    shaded = tuple(range(len(records))) if lights is None else tuple(lights)
+    name = rt_lit_group_name(features) if lights is None else culled_group_name(features, shaded)
     world = world_sync.world_environment()
     env, world_record = world if world is not None else (None, None)
     tables = _tables(lut_dir, env)
     trees, material_inputs = {}, None
     for engine, _, table_filter_mode, _ in ENGINE_TREES:
         with table_filter(table_filter_mode):
-            material = rt_lit.build_rt_lit(features, tuple(kind for _, kind in records), env)
+            material = rt_lit.build_rt_lit(features, tuple(records[i][1] for i in shaded), env)
         inputs = _TreeInputs()
-        internal = {name: inputs.geometry(_GEOMETRY_SOCKETS[name]) for name in GEOMETRY_INPUTS}
-        for per_light in material.light_inputs:
-            internal.update({name: inputs.group("lights", SCENE_LIGHTS_GROUP, -200.0, name)
-                             for name in per_light.values()})
-        internal.update({name: inputs.group("world", WORLD_GROUP, -600.0, name) for name in material.world_inputs.values()})
-        trees[engine], _ = node_emit.ensure_tree(engine_tree_name(features, engine), material.function,
+        internal = {n: inputs.geometry(_GEOMETRY_SOCKETS[n]) for n in GEOMETRY_INPUTS}
+        # the material function's light k is the scene's light shaded[k]: "Light k p" <- "Light shaded[k] p"
+        for k, per_light in enumerate(material.light_inputs):
+            internal.update({n: inputs.group("lights", SCENE_LIGHTS_GROUP, -200.0, light_input(shaded[k], param))
+                             for param, n in per_light.items()})
+        internal.update({n: inputs.group("world", WORLD_GROUP, -600.0, n) for n in material.world_inputs.values()})
+        trees[engine], _ = node_emit.ensure_tree(f"{name} [{engine}]", material.function,
                                                  material.material_inputs, sockets=(RT_LIT_INPUTS, RT_LIT_OUTPUTS),
                                                  internal_inputs=internal,
-                                                 stamp_extra=repr((records, world_record and world_record["table"])),
+                                                 stamp_extra=repr((records, shaded, world_record and world_record["table"])),
                                                  tables=tables, shader_sums={"Shader": list(material.part_outputs)})
         material_inputs = material.material_inputs
-    ng = _ensure_engine_group(rt_lit_group_name(features), trees, material_inputs)
+    ng = _ensure_engine_group(name, trees, material_inputs)
     ng[FEATURES_KEY] = features.as_dict()
+    if lights is not None:
+        ng[LIGHTS_SUBSET_KEY] = list(shaded)
     return ng
 
 
@@ -336,13 +352,110 @@ def _tables(lut_dir, env):
 
 
 def rebuild_rt_lit_groups(scene, lut_dir=None):
-    """After a light sync: rebuild every RT Lit group in the file for the scene's lights."""
+    """After a light sync: rebuild every RT Lit group in the file for the scene's lights, then give each material
+    the group of the lights that reach it (``cull_lights``)."""
     rebuilt = []
     for ng in list(bpy.data.node_groups):
-        if FEATURES_KEY in ng.keys() and ng.name.startswith(RT_LIT_GROUP_PREFIX):
+        if FEATURES_KEY in ng.keys() and ng.name.startswith(RT_LIT_GROUP_PREFIX) and LIGHTS_SUBSET_KEY not in ng:
             features = Features.from_dict(ng[FEATURES_KEY])
             rebuilt.append(ensure_rt_lit_group(features, scene, lut_dir))
+    rebuilt += cull_lights(scene, lut_dir)
     return rebuilt
+
+
+# --- lights out of range (issue 15: skip what a scene does not need) ----------------------------------------
+# A light with a range (core/lights.py, option "range") gives exactly 0 beyond it (Karis 2013's window is 0 for
+# d >= r).  A material whose objects all lie beyond a light's range gets an RT Lit group without that light:
+# the same values, fewer nodes.  Which lights reach which material is re-checked when lights or objects change
+# (``lights_out_of_sync``; the automatic light sync re-culls).
+
+def _material_bounds(scene):
+    """material name -> (min, max) corners of the world-space box around the objects that render it."""
+    bounds = {}
+    for obj in scene.objects:
+        if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT") or not is_rendered(scene, obj):
+            continue
+        names = {slot.material.name for slot in obj.material_slots if slot.material is not None}
+        if not names:
+            continue
+        m = obj.matrix_world
+        corners = [m @ mathutils.Vector(c) for c in obj.bound_box]
+        lo = [min(c[i] for c in corners) for i in range(3)]
+        hi = [max(c[i] for c in corners) for i in range(3)]
+        for name in names:
+            old = bounds.get(name)
+            bounds[name] = (lo, hi) if old is None else ([min(a, b) for a, b in zip(old[0], lo)],
+                                                         [max(a, b) for a, b in zip(old[1], hi)])
+    return bounds
+
+
+def _box_distance(point, lo, hi):
+    """Distance from ``point`` to the box [lo, hi] (0 inside)."""
+    return math.sqrt(sum(max(l - p, 0.0, p - h) ** 2 for p, l, h in zip(point, lo, hi)))
+
+
+def material_reach(scene, records):
+    """{material name: indices of the lights that can reach its objects} for the RT Lit materials some light with
+    a range cannot reach; {} when every light reaches every material."""
+    ranged = []
+    for i, (obj, kind) in enumerate(records):
+        if "range" in core_lights.split_kind(kind)[1]:
+            ranged.append((i, tuple(obj.matrix_world.translation), float(light_controls.value(obj.data, "rtl_range"))))
+    if not ranged:
+        return {}
+    out = {}
+    for name, (lo, hi) in _material_bounds(scene).items():
+        material = bpy.data.materials.get(name)
+        if material is None or FEATURES_KEY not in material.keys():
+            continue
+        out_of_range = {i for i, loc, r in ranged if _box_distance(loc, lo, hi) >= r}
+        if out_of_range:
+            out[name] = [i for i in range(len(records)) if i not in out_of_range]
+    return out
+
+
+def _reach_record(reach):
+    return repr(sorted((k, list(v)) for k, v in reach.items()))
+
+
+def cull_lights(scene, lut_dir=None):
+    """Give each RT Lit material the group of the scene lights that can reach it: the shared group when all do, a
+    culled one ("RT Lit (<features>) [lights 0, 2]") when a light's range stops short of its objects.  Culled groups
+    no material uses are removed.  Returns the culled groups in use."""
+    records = scene_lights(scene)
+    reach = material_reach(scene, records)
+    used = []
+    for material in bpy.data.materials:
+        if FEATURES_KEY not in material.keys() or material.node_tree is None or material.library is not None:
+            continue
+        node = material.node_tree.nodes.get(RT_LIT_NODE_NAME)
+        if node is None or node.node_tree is None:
+            continue
+        features = Features.from_dict(material[FEATURES_KEY])
+        lights = reach.get(material.name)
+        group = (ensure_rt_lit_group(features, scene, lut_dir, lights) if lights is not None
+                 else bpy.data.node_groups.get(rt_lit_group_name(features)) or ensure_rt_lit_group(features, scene, lut_dir))
+        if node.node_tree != group:
+            node.node_tree = group
+        if lights is not None:
+            used.append(group)
+    _remove_groups([ng for ng in bpy.data.node_groups if LIGHTS_SUBSET_KEY in ng and ng not in used and ng.users == 0])
+    lights_group = bpy.data.node_groups.get(SCENE_LIGHTS_GROUP)
+    if lights_group is not None:
+        lights_group[REACH_KEY] = _reach_record(reach)
+    return used
+
+
+def _remove_groups(groups):
+    """Remove RT Lit groups and then their engine trees that nothing else uses."""
+    names = {n.node_tree.name for ng in groups for n in ng.nodes
+             if n.bl_idname == "ShaderNodeGroup" and n.node_tree is not None}
+    for ng in groups:
+        bpy.data.node_groups.remove(ng)
+    for name in names:
+        tree = bpy.data.node_groups.get(name)
+        if tree is not None and tree.users == 0:
+            bpy.data.node_groups.remove(tree)
 
 
 def assign_rt_lit(material, features=None, scene=None, lut_dir=None):

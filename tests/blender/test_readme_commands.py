@@ -42,6 +42,7 @@ RUN_BY = {
     "scripts/build_presets.py": "here",
     "scripts/benchmark_wrapped_diffuse.py": "here",
     "scripts/benchmark_light_fallback.py": "here",
+    "scripts/benchmark_light_culling.py": "here",
 }
 
 #: The commands run here: (script, arguments, files it must write under the output folder).
@@ -57,6 +58,8 @@ SMOKE = {
     "scripts/benchmark_wrapped_diffuse.py": (["--quick", "--lights", "4", "--out", "{out}"],
                                              ["wrapped_diffuse.md", "wrapped_diffuse.json"]),
     "scripts/benchmark_light_fallback.py": (["--quick", "--out", "{out}"], ["light_fallback.md", "light_fallback.json"]),
+    "scripts/benchmark_light_culling.py": (["--quick", "--scenes", "grid", "--out", "{out}"],
+                                           ["light_culling.md", "light_culling.json"]),
 }
 
 

@@ -1,0 +1,110 @@
+"""Lights out of range are left out of a material's tree (issue 15: skip what a scene does not need): a light with a
+range gives exactly 0 beyond it, so a material whose objects all lie farther gets an RT Lit group without it; the
+render is the same, the tree smaller; moving a light or an object re-culls."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("OpenEXR")
+
+pytestmark = pytest.mark.blender
+
+
+def _scene(bpy, lut_dir, ranged=True):
+    """Three spheres 6 m apart, each with its own RT Lit material; a point light with a 3 m range beside each, and
+    a sun without one; an orthographic camera."""
+    from rt_lookdev.addon import compat, materials
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+    from rt_lookdev.validation import energy_render
+
+    scene = bpy.context.scene
+    mesh = energy_render._uv_sphere_mesh(bpy, "cull_sphere", 48, 24)
+    for i in range(3):
+        data = bpy.data.lights.new(f"Point {i}", "POINT")
+        data.energy, data.shadow_soft_size = 300.0, 0.0
+        data["rtl_use_range"], data["rtl_range"] = ranged, 3.0
+        light = bpy.data.objects.new(f"Point {i}", data)
+        light.location = (6.0 * i - 6.0, -2.0, 1.0)
+        scene.collection.objects.link(light)
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.angle, sun.data.energy = 0.0, 1.0
+    scene.collection.objects.link(sun)
+    materials.sync_scene_lights(scene)
+    for i in range(3):
+        mat = compat.new_material(f"Cull {i}")
+        materials.assign_rt_lit(mat, Features("turquin", "cod"), scene, lut_dir)
+        obj = bpy.data.objects.new(f"Sphere {i}", mesh.copy())
+        obj.data.materials.append(mat)
+        obj.location = (6.0 * i - 6.0, 0.0, 0.0)
+        scene.collection.objects.link(obj)
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.data.type, cam.data.ortho_scale = "ORTHO", 18.0
+    cam.location, cam.rotation_euler = (0.0, -20.0, 0.0), (np.pi / 2, 0.0, 0.0)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    scene.render.resolution_x, scene.render.resolution_y = 180, 60
+    bpy.context.view_layer.update()                  # world matrices, as a depsgraph update leaves them
+    materials.rebuild_rt_lit_groups(scene, lut_dir)
+    return scene
+
+
+def _render(scene):
+    from rt_lookdev.validation.engines import render_cycles_passes
+
+    return render_cycles_passes(scene, (scene.render.resolution_x, scene.render.resolution_y))["Combined"]
+
+
+def test_each_material_gets_only_the_lights_that_reach_it(empty_scene, lut_dir):
+    import bpy
+
+    from rt_lookdev.addon import materials
+    from rt_lookdev.addon.common import LIGHTS_SUBSET_KEY
+
+    scene = _scene(bpy, lut_dir)
+    groups = {i: bpy.data.materials[f"Cull {i}"].node_tree.nodes["RT Lit"].node_tree for i in range(3)}
+    # lights in name order: Point 0, Point 1, Point 2, Sun
+    assert [list(g[LIGHTS_SUBSET_KEY]) for g in groups.values()] == [[0, 3], [1, 3], [2, 3]]
+    culled = {i: sum(materials.engine_node_counts(g).values()) for i, g in groups.items()}
+    image = _render(scene)
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = _scene(bpy, lut_dir, ranged=False)
+    full_group = bpy.data.materials["Cull 0"].node_tree.nodes["RT Lit"].node_tree
+    assert LIGHTS_SUBSET_KEY not in full_group
+    # without ranges every material shades all four lights
+    full = sum(materials.engine_node_counts(full_group).values())
+    print(f"nodes per material: culled {culled}, all lights {full}")
+    assert max(culled.values()) < 0.75 * full
+    assert np.isfinite(image).all() and image.max() > 0.05
+
+
+def test_culling_changes_no_value_and_follows_moves(empty_scene, lut_dir):
+    """A culled light contributes exactly 0 (the window is 0 at and beyond the range), so the culled render equals
+    the render with every light in every tree (forced by a range test that never culls); moving a light into reach
+    re-culls."""
+    import bpy
+
+    from rt_lookdev.addon import materials
+
+    scene = _scene(bpy, lut_dir)
+    culled = _render(scene)
+    original = materials.material_reach
+    try:
+        materials.material_reach = lambda scene, records: {}
+        materials.rebuild_rt_lit_groups(scene, lut_dir)
+        assert all(len(bpy.data.materials[f"Cull {i}"].node_tree.nodes["RT Lit"].node_tree.name.split("[")) == 1
+                   for i in range(3))
+        everything = _render(scene)
+    finally:
+        materials.material_reach = original
+    print(f"culled vs every light: max |difference| {np.abs(culled - everything).max():.2e}")
+    np.testing.assert_allclose(culled, everything, rtol=0, atol=1e-6)
+    materials.rebuild_rt_lit_groups(scene, lut_dir)
+    assert not materials.lights_out_of_sync(scene)
+    bpy.data.objects["Point 0"].location = (0.0, -2.0, 1.0)                # now it reaches sphere 1, not sphere 0
+    bpy.context.view_layer.update()
+    assert materials.lights_out_of_sync(scene)
+    materials.rebuild_rt_lit_groups(scene, lut_dir)
+    groups = [bpy.data.materials[f"Cull {i}"].node_tree.nodes["RT Lit"].node_tree.name for i in range(3)]
+    assert groups[0].endswith("[lights 3]") and groups[1].endswith("[lights 0, 1, 3]")
