@@ -366,32 +366,50 @@ def rebuild_rt_lit_groups(scene, lut_dir=None):
 # --- lights out of range (issue 15: skip what a scene does not need) ----------------------------------------
 # A light with a range (core/lights.py, option "range") gives exactly 0 beyond it (Karis 2013's window is 0 for
 # d >= r).  A material whose objects all lie beyond a light's range gets an RT Lit group without that light:
-# the same values, fewer nodes.  Which lights reach which material is re-checked when lights or objects change
-# (``lights_out_of_sync``; the automatic light sync re-culls).
+# the same values, fewer nodes.  "Beyond" is tested against a sphere around each object (conservative: a light
+# may be kept that a box would cull), so the check stays cheap enough for every depsgraph update (1.4 ms on a
+# 100-object scene with 10 ranged lights, docs/benchmarks/light_sync.md).  Which lights reach which material is
+# re-checked when lights or objects change (``lights_out_of_sync``; the automatic light sync re-culls).
 
-def _material_bounds(scene):
-    """material name -> (min, max) corners of the world-space box around the objects that render it."""
-    bounds = {}
-    for obj in scene.objects:
-        if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT") or not is_rendered(scene, obj):
+def _rendered_objects(scene):
+    """The objects a render of ``scene`` includes (as ``is_rendered``, in one pass over the collections)."""
+    names = set()
+    for layer in scene.view_layers:
+        if layer.use:
+            names |= _layer_collections(scene, layer)
+    hidden = {c.name for c in bpy.data.collections if c.hide_render}
+    out = {o for o in scene.collection.objects if not o.hide_render} if scene.collection.name in names else set()
+    for name in names - hidden:
+        collection = bpy.data.collections.get(name)
+        if collection is not None:
+            out.update(o for o in collection.objects if not o.hide_render)
+    # an object in a hidden collection is hidden, whatever other collection also holds it (``is_rendered``)
+    for name in hidden:
+        out.difference_update(bpy.data.collections[name].objects)
+    return out
+
+
+_GEOMETRY = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
+
+
+def _material_spheres(scene):
+    """{material name: [(world centre, radius)]}: a sphere around each rendered object using the material (its
+    bounding box's centre and half-diagonal, times its largest scale: conservative, and cheap for every update)."""
+    spheres = {}
+    for obj in _rendered_objects(scene):
+        if obj.type not in _GEOMETRY:
             continue
         names = {slot.material.name for slot in obj.material_slots if slot.material is not None}
         if not names:
             continue
+        lo, hi = obj.bound_box[0], obj.bound_box[6]
         m = obj.matrix_world
-        corners = [m @ mathutils.Vector(c) for c in obj.bound_box]
-        lo = [min(c[i] for c in corners) for i in range(3)]
-        hi = [max(c[i] for c in corners) for i in range(3)]
+        centre = m @ mathutils.Vector(((lo[0] + hi[0]) * 0.5, (lo[1] + hi[1]) * 0.5, (lo[2] + hi[2]) * 0.5))
+        half = mathutils.Vector(((hi[0] - lo[0]) * 0.5, (hi[1] - lo[1]) * 0.5, (hi[2] - lo[2]) * 0.5)).length
+        radius = half * max(abs(x) for x in m.to_scale())
         for name in names:
-            old = bounds.get(name)
-            bounds[name] = (lo, hi) if old is None else ([min(a, b) for a, b in zip(old[0], lo)],
-                                                         [max(a, b) for a, b in zip(old[1], hi)])
-    return bounds
-
-
-def _box_distance(point, lo, hi):
-    """Distance from ``point`` to the box [lo, hi] (0 inside)."""
-    return math.sqrt(sum(max(l - p, 0.0, p - h) ** 2 for p, l, h in zip(point, lo, hi)))
+            spheres.setdefault(name, []).append((tuple(centre), radius))
+    return spheres
 
 
 def material_reach(scene, records):
@@ -404,11 +422,11 @@ def material_reach(scene, records):
     if not ranged:
         return {}
     out = {}
-    for name, (lo, hi) in _material_bounds(scene).items():
+    for name, spheres in _material_spheres(scene).items():
         material = bpy.data.materials.get(name)
         if material is None or FEATURES_KEY not in material.keys():
             continue
-        out_of_range = {i for i, loc, r in ranged if _box_distance(loc, lo, hi) >= r}
+        out_of_range = {i for i, loc, r in ranged if all(math.dist(loc, c) - radius >= r for c, radius in spheres)}
         if out_of_range:
             out[name] = [i for i in range(len(records)) if i not in out_of_range]
     return out

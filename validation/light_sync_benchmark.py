@@ -94,10 +94,17 @@ def run(args, log=print):
             t = time.perf_counter()
             assert light_sync.sync_if_needed(scene)
             resync.append((time.perf_counter() - t) * 1e3)
+        # lights with a range: each update also checks which lights reach which material (materials.cull_lights)
+        for obj in [o for o in scene.objects if o.type == "LIGHT" and o.data.type != "SUN"]:
+            obj.data["rtl_use_range"], obj.data["rtl_range"] = True, 1000.0
+        bpy.context.view_layer.update()
+        light_sync.sync_if_needed(scene)
+        ranged = _median_ms(lambda: light_sync.sync_if_needed(scene), args.repeats)
+        assert not light_sync.sync_if_needed(scene), "a reach that did not change must not re-sync"
     finally:
         light_sync.unregister()
     result = {"objects": args.objects, "lights": args.lights, "repeats": args.repeats,
-              "no_change_check_ms": round(check, 4),
+              "no_change_check_ms": round(check, 4), "no_change_check_with_ranges_ms": round(ranged, 4),
               "update_moving_a_light_ms": {"without_handler": round(without, 4), "with_handler": round(with_handler, 4),
                                            "difference": round(with_handler - without, 4)},
               "resync_adding_a_light_ms": round(statistics.median(resync), 1),
@@ -119,6 +126,8 @@ def format_markdown(r):
         f"materials; medians of {r['repeats']} calls, Blender {r['blender']}, one process.", "",
         "| what | median |", "|---|---|",
         f"| handler's check on an update that changes no light (a light moved) | {r['no_change_check_ms']:.3f} ms |",
+        f"| the same with every light given a range (the check of which lights reach which material) | "
+        f"{r['no_change_check_with_ranges_ms']:.3f} ms |",
         f"| `view_layer.update()` after moving a light, without the handler | {u['without_handler']:.3f} ms |",
         f"| the same with the handler registered | {u['with_handler']:.3f} ms |",
         f"| difference | {u['difference']:.3f} ms |",
