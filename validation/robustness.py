@@ -31,7 +31,9 @@ from ..core import lights as light_math
 from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import RADIANCE_OUTPUT, Features
 
-LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun")
+#: The five Blender light kinds, then the talk's light controls (core/lights.py): range and cone on area lights,
+#: and the quad-to-spot fallback with a range.
+LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad+cone+range", "disk+cone+range", "quad_spot+range")
 AREA_KINDS = ("quad", "disk")
 #: Allowed excess over the white-furnace bound (relative): float32 rounding and bilinear lookups.
 BOUND_TOLERANCE = 1e-3
@@ -71,6 +73,7 @@ FAMILIES = (
     Family("Lambert diffuse", Features("single", "lambert", cloth=True), _DIFFUSE_ALONE),
     Family("CoD WWII diffuse", Features("single", "cod", cloth=True), _DIFFUSE_ALONE),
     Family("Wrapped diffuse", Features("single", "wrapped", cloth=True), dict(_DIFFUSE_ALONE, Wrap=(0.0, 1.0))),
+    Family("CoD wrapped diffuse", Features("none", "cod_wrapped"), dict(_DIFFUSE_ALONE, Wrap=(0.0, 1.0))),
     Family("Ashikhmin cloth", Features("single", "lambert", cloth=True),
            {"Metallic": 0.0, "Base Color": "black", "Cloth Weight": 1.0, "Cloth Color": "white"}),
     Family("Disney sheen", Features("single", "lambert", sheen=True, cloth=True),
@@ -78,6 +81,8 @@ FAMILIES = (
             "Sheen Weight": 1.0, "Sheen Tint": "white"}),
     Family("Dielectric: Lambert + GGX", Features("turquin", "lambert"), _DIELECTRIC, LAYERED),
     Family("Dielectric: CoD + GGX", Features("turquin", "cod"), _DIELECTRIC, LAYERED),
+    Family("Turquin, mixed metal", Features("turquin", "lambert"),
+           {"Metallic": (0.0, 1.0), "Base Color": "random", "Specular Tint": "random"}, LAYERED),
     Family("Everything on, mixed metal", Features("kulla_conty", "cod", sheen=True, cloth=True),
            {"Metallic": (0.0, 1.0), "Base Color": "random", "Specular Tint": "random", "Wrap": (0.0, 1.0),
             "Sheen Weight": (0.0, 1.0), "Sheen Tint": "random", "Cloth Weight": (0.0, 1.0),
@@ -212,15 +217,25 @@ def _light_values(rng, kind, position, normal, n):
     size_y = np.minimum(size_y, 1e6 / np.maximum(np.abs(scale[:, 1]), 1e-30))
     vals.update({"Size": size, "Size Y": size_y, "Spot Size": _mix_special(rng, rng.uniform(0, np.pi, n),
                                                                              [0.0, np.pi], 0.05),
-                 "Spot Blend": _mix_special(rng, rng.random(n), [0.0, 1.0], 0.1)})
+                 "Spot Blend": _mix_special(rng, rng.random(n), [0.0, 1.0], 0.1),
+                 # the light controls: ranges from 1 mm to 1000 km and 0 (off), cone angles from 0 to pi
+                 "Range": _mix_special(rng, _log_uniform(rng, 1e-3, 1e6, n), [0.0], 0.03),
+                 "Cone Inner": _mix_special(rng, rng.uniform(0, np.pi, n), [0.0, np.pi], 0.05),
+                 "Cone Outer": _mix_special(rng, rng.uniform(0, np.pi, n), [0.0, np.pi], 0.05)})
     params = rt_lit.light_parameters(kind)
     return {p: vals[p] for p in params}, _unit_light(kind, vals, position)
 
 
 def _unit_light(kind, vals, position):
     """What one unit of the light is at the point (float64): the emitted radiance of an area light, the
-    irradiance at normal incidence of a point, spot or sun light (white light)."""
+    irradiance at normal incidence of a point, spot or sun light (white light); a light's options (range, cone)
+    only attenuate it.  The quad-to-spot fallback: its on-axis intensity P / pi over the squared distance."""
+    kind = light_math.base_kind(kind)
     with np.errstate(all="ignore"):
+        if kind == "quad_spot":
+            loc = np.stack([vals["Location X"], vals["Location Y"], vals["Location Z"]], -1)
+            d2 = np.maximum(((loc - position) ** 2).sum(-1), light_math.MIN_DISTANCE ** 2)
+            return vals["Power"] / (np.pi * d2)
         if kind in AREA_KINDS:
             half_u = np.abs(vals["Scale X"] * vals["Size"]) * 0.5
             half_v = np.abs(vals["Scale Y"] * vals["Size Y"]) * 0.5
@@ -319,7 +334,7 @@ def count(family, kind, backend, got, ref64, unit, values, material, seconds=0.0
     with np.errstate(all="ignore"):
         response = np.where(unit > 0, got / np.where(unit > 0, unit, 1.0), 0.0)
         response64 = np.where(unit > 0, ref64 / np.where(unit > 0, unit, 1.0), 0.0)
-    if kind in AREA_KINDS + ("world",):
+    if kind == "world" or light_math.base_kind(kind) in AREA_KINDS:
         limit = np.broadcast_to(np.asarray(bound(family, values), np.float64), (got.shape[0],))[:, None]
         ratio = response[finite] / limit[finite]
         c.over_bound = int((ratio > 1.0 + BOUND_TOLERANCE).any(-1).sum())

@@ -187,7 +187,8 @@ def _wrapped(point, n, wrap):
     return WRAPPED_LIGHT_POINT(Point=point, N=n, Wrap=wrap)["Direction"]
 
 
-#: Least cosine between a mapped disk point and the mapped centre, for projecting the points back onto a plane.
+#: Least cosine between a mapped disk point's direction and the light's plane normal, for placing it back on the
+#: plane.
 WRAPPED_DISK_COS_MIN = 0.05
 
 
@@ -207,24 +208,29 @@ def light_shines(light, p):
 
 
 def wrapped_light(light, p, n, wrap):
-    """The light's image under the normalised wrap seen from ``p`` (unit distance), two-sided: a ``QuadLight`` of
-    the mapped corners, or a ``DiskLight`` through the mapped ends of the semi-axes, projected onto the plane
-    through the mapped centre at the centre's distance (conjugate semi-axes of the image, to first order)."""
+    """The light's image under the normalised wrap seen from ``p``, two-sided: a ``QuadLight`` of the mapped corners
+    (unit distance), or a ``DiskLight`` through the mapped ends of the semi-axes placed back on the light's plane
+    (conjugate semi-axes of the image, to first order; w = 0 gives the light itself)."""
     if isinstance(light, QuadLight):
         corners = [p + _wrapped(q - p, n, wrap) for q in light.corner_list()]
         return QuadLight(corners, two_sided=True, center_point=p + _wrapped(light.center() - p, n, wrap))
     c = light.center - p
-    axis = _wrapped(c, n, wrap)
-    distance = op.length(c)
+    normal = op.cross(light.axis_u, light.axis_v)
+    depth = op.dot(normal, c)
+    side = op.select(op.greater(depth, 0.0), 1.0, -1.0)
+    floor = WRAPPED_DISK_COS_MIN * op.length(normal)
 
+    # where the mapped direction meets the light's plane: w = 0 gives the disk's own points; a direction the wrap
+    # turned (nearly) parallel to the plane is taken at a grazing hit
     def on_plane(point):
         d = _wrapped(point, n, wrap)
-        return op.scale(d, distance / op.maximum(op.dot(d, axis), WRAPPED_DISK_COS_MIN))
+        return op.scale(d, op.absolute(depth) / op.maximum(op.dot(normal, d) * side, floor))
 
     u1, u2 = on_plane(c + light.axis_u), on_plane(c - light.axis_u)
     v1, v2 = on_plane(c + light.axis_v), on_plane(c - light.axis_v)
-    center = op.scale(u1 + u2 + v1 + v2, 0.25)
-    return DiskLight(p + center, op.scale(u1 - u2, 0.5), op.scale(v1 - v2, 0.5), two_sided=True)
+    # the centre mapped itself, not the mean of the four points: for a light much larger than its distance the
+    # points are ~|axis| away and their mean loses the centre to float32 rounding
+    return DiskLight(p + on_plane(c), op.scale(u1 - u2, 0.5), op.scale(v1 - v2, 0.5), two_sided=True)
 
 
 def cod_wrapped_diffuse(tables, light, p, n, v, roughness, albedo, wrap):
