@@ -638,8 +638,8 @@ def parse_args(argv):
 
     p = argparse.ArgumentParser(description="The robustness sweep: NaN / Inf / negative / over-bound counts per "
                                             "technique family, light kind and backend")
-    p.add_argument("--points", type=int, default=200_000, help="points per family and light kind (default 2e5: "
-                                                                "1e6 per family over the five light kinds)")
+    p.add_argument("--points", type=int, default=125_000, help="points per family and light kind (default 1.25e5: "
+                                                                "1e6 per family over the eight light kinds)")
     p.add_argument("--image-points", type=int, default=None, help="of those, how many the image backends "
                                                                    "(Cycles, GLSL) evaluate (default: all)")
     p.add_argument("--backends", default="numpy,glsl,cycles", help="comma-separated: numpy, glsl, cycles")

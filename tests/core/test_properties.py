@@ -280,7 +280,7 @@ def test_sweep_script_writes_its_report(tmp_path):
     assert run.returncode == 0, run.stdout + run.stderr
     result = json.loads(out.with_suffix(".json").read_text())
     assert result["failures"] == 0 and "| Kulla-Conty multiple scattering |" in out.read_text()
-    assert sum(c["points"] for c in result["counts"]) == 200 * 5 * len(robustness.FAMILIES) + 200
+    assert sum(c["points"] for c in result["counts"]) == 200 * len(robustness.LIGHT_KINDS) * len(robustness.FAMILIES) + 200
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
