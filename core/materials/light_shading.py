@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import functools
 
-from .. import lights, multiscatter
+from .. import lights, multiscatter, rough_diffuse
 from .. import shading_ops as op
 from ..fresnel import fresnel_average
 from ..ir.functions import NodeFunction
@@ -50,6 +50,8 @@ def combine_lobes(features, surface, lobe_values, light_color, area=False):
         w = surface["Cloth Weight"]
         spec = op.scale(spec, 1.0 - w) + op.scale(cloth, w)
     total = spec + op.scale(surface["Albedo"], lobe_values["Diffuse"])
+    if features.diffuse == "oren_nayar":
+        total = total + _rough_diffuse_multiscatter(surface, lobe_values)
     if features.sheen:
         total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
     return op.vmul(light_color, total)
@@ -59,11 +61,20 @@ def _without_specular(features, surface, lobe_values, light_color):
     """``combine_lobes`` with the specular switched off: the cloth lobe still blends in by Cloth Weight
     (over no specular), the diffuse and sheen add."""
     total = op.scale(surface["Albedo"], lobe_values["Diffuse"])
+    if features.diffuse == "oren_nayar":
+        total = total + _rough_diffuse_multiscatter(surface, lobe_values)
     if features.cloth:
         total = total + op.scale(op.scale(surface["Cloth Color"], lobe_values["Cloth"]), surface["Cloth Weight"])
     if features.sheen:
         total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
     return op.vmul(light_color, total)
+
+
+def _rough_diffuse_multiscatter(surface, lobe_values):
+    """The rough diffuse's multiple-scattering lobe in colour: Cycles' albedo x rho_ms(base colour) per channel
+    (core/rough_diffuse.py; Principled's diffuse weight is base x (1 - metallic), its lobe colour the base)."""
+    color = rough_diffuse.multiscatter_color(surface["Albedo"], surface["Metal F0"], surface["Diffuse Roughness"])
+    return op.scale(color, lobe_values["Diffuse MS"])
 
 
 def lobe_keys(features):
@@ -80,6 +91,13 @@ def lobe_keys(features):
 
 #: The surface terms a light's shading reads.
 SHADE_SURFACE = ("N", "V", "Roughness", "F0", "Albedo", "Wrap", "Sheen Color", "Cloth Weight", "Cloth Color")
+#: ... and those the rough diffuse adds (only groups built with it read them).
+ROUGH_DIFFUSE_SURFACE = ("Diffuse Roughness", "Metal F0")
+
+
+def shade_surface(features):
+    """The surface terms the shading of ``features`` reads."""
+    return SHADE_SURFACE + (ROUGH_DIFFUSE_SURFACE if features.diffuse == "oren_nayar" else ())
 
 
 def light_color_name(kind):
@@ -103,13 +121,14 @@ def shade_function(kind, features):
             values.update(fn(tables, **_arguments(fn, kw)))
         return {"Radiance": combine_lobes(features, kw, values, kw[color_name], kind in lobes.AREA_KINDS)}
 
-    inputs = {k: SURFACE_OUTPUTS[k] for k in SHADE_SURFACE}
+    surface_names = shade_surface(features)
+    inputs = {k: SURFACE_OUTPUTS[k] for k in surface_names}
     if kind in lobes.AREA_KINDS + ("point", "spot"):
         inputs["Position"] = GEOMETRY_INPUTS["Position"]
     inputs.update(lobes.light_geometry_sockets(kind))
     inputs[color_name] = lights.LIGHT_DATA[kind].output_sockets[color_name]
     # only the inputs some lobe or the combination reads
-    used = set(SHADE_SURFACE) | {color_name}.union(*(fn.input_sockets for fn in functions))
+    used = set(surface_names) | {color_name}.union(*(fn.input_sockets for fn in functions))
     inputs = {k: v for k, v in inputs.items() if k in used}
     title = kind.capitalize() if kind not in lobes.AREA_KINDS else f"{kind.capitalize()} Area"
     return NodeFunction(f"RTL Shade {title} ({features.label()})", shade, inputs,
