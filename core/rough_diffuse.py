@@ -126,6 +126,12 @@ def ms_kernel(mu):
     return op.select(op.greater(mu, 0.0), fon_g_deficit(c) * c * (1.0 / _MS_NORM), 0.0)
 
 
+def ms_kernel_over_cosine(mu):
+    """pi ms_kernel(mu) / mu = (G(0) - G(mu)) / (pi (c1 - c2)): the kernel relative to the clamped cosine / pi
+    (0 at grazing, 1.34 at the normal), without the division by mu."""
+    return fon_g_deficit(op.maximum(mu, 0.0)) * (1.0 / (PI * (C1 - C2)))
+
+
 def multiscatter_cos(mu_l, mu_v, r):
     """EON's f_ms times the cosine with rho_ms = 1: (1 - E_F(mu_v)) (1 - E_F(mu_l)) mu_l / (pi (1 - E_avg))
     = (1 - E_F(mu_v)) ms_kernel(mu_l); 0 below either horizon."""
@@ -178,11 +184,13 @@ def ms_kernel_zonal(n=256):
 MS_KERNEL_ZONAL = (1.0, 0.740051590, 0.378505935)
 
 
-# --- the multiple-scattering kernel over an area light -------------------------------------------------------
-# int_light ms_kernel dw has no closed form through the LTC machinery, but the kernel is one fixed lobe about N, so
-# one fixed LTC approximates it for every roughness (Heitz et al. 2016: an LTC with Minv = diag(1, 1, c3) is
-# isotropic about N).  c3 minimises the total-variation distance to the kernel (``ms_kernel_ltc_tv``): 0.0585,
-# against 0.130 for the plain cosine (c3 = 1).
+# --- the multiple-scattering kernel over an area light: an alternative, measured ------------------------------
+# Shading integrates the kernel over a light as the Lambert form factor x ``ms_kernel_over_cosine`` towards the
+# light's centre (core/materials/lobes.py).  The kernel being one fixed lobe about N, one fixed LTC also
+# approximates it for every roughness (Heitz et al. 2016: an LTC with Minv = diag(1, 1, c3) is isotropic about N);
+# c3 minimises the total-variation distance to the kernel (``ms_kernel_ltc_tv``): 0.0585, against 0.130 for the
+# plain cosine (c3 = 1).  Against Cycles the centre form measured better (docs/rough_diffuse.md), so this LTC is
+# kept for that comparison (validation/ltc_benchmark.py).
 
 def ms_kernel_ltc_tv(c3, n=20000):
     """Total-variation distance 1/2 int |ms_kernel - D_ltc| dw between the kernel and the isotropic LTC

@@ -193,8 +193,9 @@ def _brute(kind, light, f_cos, order=24):
 def test_area_lobe_against_brute_force(lut_dir, kind):
     """Lights above the horizon, 0.6 to 3 units wide at 1.5 to 4.  Measured with this generator over 150 lights
     per kind (seed 100): single scattering (its fitted LTC x the closed-form albedo) median 0.9% / p90 4% / max
-    20% from the brute force; the multiple-scattering kernel through its fixed LTC median 6.1% / p90 10% / max
-    12% (the LTC's TV distance to the kernel is 0.059).  Bounds here with margin, on 12 lights."""
+    20% from the brute force; the multiple-scattering kernel (Lambert form factor x its ratio towards the light's
+    centre) median 1.7% / p90 4.7% / max 9.1% (through the fixed LTC rough_diffuse.MS_KERNEL_LTC instead: 6.1% /
+    10% / 12%).  Bounds here with margin, on 12 lights."""
     tables = lookup.LutSet.from_folder(lut_dir)
     rng = np.random.default_rng(11 if kind == "quad" else 12)
     fn = lobes.OREN_NAYAR.function(kind)
@@ -212,7 +213,7 @@ def test_area_lobe_against_brute_force(lut_dir, kind):
     print(kind, "ss median %.4f max %.4f, ms median %.4f max %.4f" % (np.median(ss_err), max(ss_err),
                                                                       np.median(ms_err), max(ms_err)))
     assert np.median(ss_err) < 0.02 and max(ss_err) < 0.25
-    assert np.median(ms_err) < 0.09 and max(ms_err) < 0.15
+    assert np.median(ms_err) < 0.03 and max(ms_err) < 0.12
 
 
 # --- the world term --------------------------------------------------------------------------------------
