@@ -44,6 +44,8 @@ err_ab.png}; the bakes in <out>/env_cache (``--cache``).
 Usage:
     python scripts/validate_world.py [--quick] [--hdri NAME ...] [--out DIR] [--samples 768] [--cell 32]
     blender --background --python scripts/validate_world.py -- [same options]   (needs OpenEXR importable)
+    python scripts/validate_world.py --rough-diffuse only   (the rough diffuse and CoD vs Cycles' rough Diffuse
+                                                             BSDF, docs/rough_diffuse.md; "add": beside the rest)
 Full run: 7-9 minutes on 2 cores (521 s measured with other jobs on the machine; about 6 min with
 --samples 512); --quick (one rotated HDRI, few spheres, 256 spp): about 22 s.
 """
