@@ -41,6 +41,8 @@ MAPPED_INPUTS = (
     "Base Color", "Metallic", "Roughness", "IOR", "Specular IOR Level", "Specular Tint",
     "Sheen Weight", "Sheen Tint", "Emission Color", "Emission Strength", "Normal",
 )
+#: Principled's Diffuse Roughness (Blender 4.3+) drives RT Lit's "oren_nayar" diffuse (core/rough_diffuse.py).
+MAPPED_INPUTS += ("Diffuse Roughness",)
 #: Inputs whose value is never copied (only their link): the value is hidden and unused.
 LINK_ONLY_INPUTS = ("Normal",)
 #: RT Lit inputs with no Principled counterpart; their values are remembered on the material.
@@ -74,6 +76,8 @@ DIFFUSE_LABELS = {
     "wrapped": ("Wrapped", "Energy-conserving wrapped diffuse (uses the Wrap input)"),
     "cod_wrapped": ("CoD WWII Wrapped", "Multiscattering diffuse with wrapped lighting, the talk's closing table "
                                         "(uses the Wrap input)"),
+    "oren_nayar": ("Oren-Nayar (Cycles)", "Rough diffuse as Cycles shades Principled's Diffuse Roughness: Fujii's "
+                   "Oren-Nayar with EON's multiple scattering (uses the Diffuse Roughness input)"),
 }
 
 SPECULAR_ITEMS = tuple((m, *SPECULAR_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SPECULAR_MODELS)
@@ -317,14 +321,26 @@ def draw_switches(layout, owner):
 def principled_uses_sheen(material):
     """Whether ``material``'s Principled BSDF (feeding its active output) has sheen: Sheen Weight > 0 or
     linked.  The Convert dialog turns the sheen switch on for it."""
+    return _principled_input_used(material, "Sheen Weight")
+
+
+def principled_uses_diffuse_roughness(material):
+    """Whether ``material``'s Principled BSDF has a rough diffuse: Diffuse Roughness > 0 or linked.  The Convert
+    dialog proposes the "oren_nayar" diffuse for it (what Cycles renders)."""
+    return _principled_input_used(material, "Diffuse Roughness")
+
+
+def _principled_input_used(material, name):
+    """Whether the Principled BSDF feeding ``material``'s active output has input ``name`` linked or above 0
+    (False without such a node or input)."""
     if material is None or material.node_tree is None:
         return False
     output = _active_output(material.node_tree)
     node = _source_node(output.inputs["Surface"]) if output is not None else None
-    if node is None or node.bl_idname != "ShaderNodeBsdfPrincipled":
+    if node is None or node.bl_idname != "ShaderNodeBsdfPrincipled" or node.inputs.get(name) is None:
         return False
-    sheen = node.inputs["Sheen Weight"]
-    return bool(sheen.is_linked or sheen.default_value > 0.0)
+    socket = node.inputs[name]
+    return bool(socket.is_linked or socket.default_value > 0.0)
 
 
 def stored_features(material):
@@ -520,6 +536,11 @@ def principled_to_rt_lit(material, group_factory, features=None):
         amount = "a linked Sheen Weight" if sheen.is_linked else f"Sheen Weight {sheen.default_value:.3g}"
         result.warnings.append(f"Material '{material.name}': {amount} is not shaded because the sheen switch is "
                                "off; convert again with Sheen on to keep it")
+    rough = principled.inputs.get("Diffuse Roughness")
+    if features.diffuse != "oren_nayar" and rough is not None and (rough.is_linked or rough.default_value > 0.0):
+        amount = "a linked Diffuse Roughness" if rough.is_linked else f"Diffuse Roughness {rough.default_value:.3g}"
+        result.warnings.append(f"Material '{material.name}': {amount} is not shaded by the '{features.diffuse}' "
+                               "diffuse; convert again with the Oren-Nayar diffuse to keep it")
     if ignored:
         result.warnings.append(
             f"Material '{material.name}': RT Lit ignores the Principled inputs "
@@ -708,6 +729,8 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
             self.environment_ms = stored.environment_ms
         else:
             self.sheen = self.sheen or principled_uses_sheen(material)
+            if principled_uses_diffuse_roughness(material):
+                self.diffuse = "oren_nayar"
         return context.window_manager.invoke_props_dialog(self)
 
     def draw(self, context):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter
+from ..core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter, rough_diffuse
 from ..core.conventions import alpha_from_roughness
 
 #: Side of the square per-texel grids (one render pixel per texel).
@@ -65,6 +65,16 @@ TECHNIQUES = {
     "cone_falloff": (falloff.cone_falloff, ["cos_to_axis", "inner_angle", "outer_angle"]),
     "projector_distance": (falloff.projector_distance, ["diameter", "outer_angle"]),
 }
+#: The rough diffuse (core/rough_diffuse.py): single scattering (Fujii) and the multiple-scattering lobe (EON).
+TECHNIQUES["oren_nayar_single"] = (rough_diffuse.fon_single_scatter_cos, ["mu_l", "mu_v", "l_dot_v", "r"])
+TECHNIQUES["oren_nayar_multi"] = (rough_diffuse.multiscatter_cos, ["mu_l", "mu_v", "r"])
+
+
+def _diffuse_roughness(rng, shape):
+    """Diffuse roughness per texel, with 0, 1e-3 and 1 in the first texels."""
+    sigma = rng.random(shape).astype(np.float32)
+    sigma.reshape(-1)[:6] = [0.0, 1.0, 1e-3, 1.0, 0.5, 0.0]
+    return sigma
 
 
 def technique_inputs(names, n=4000, seed=0):
@@ -101,7 +111,7 @@ def punctual_lobe_inputs(seed=3, size=SIZE):
     r.reshape(-1)[:8] = [0.0, 1.0, 0.0, 1.0, 0.5, 0.0, 1e-3, 1.0]
     wrap = rng.random(shape).astype(np.float32)
     wrap.reshape(-1)[:3] = [0.0, 1.0, 1.0]
-    return {"N": n, "V": v, "L": l, "Roughness": r, "Wrap": wrap}
+    return {"N": n, "V": v, "L": l, "Roughness": r, "Wrap": wrap, "Diffuse Roughness": _diffuse_roughness(rng, shape)}
 
 
 def area_lobe_inputs(kind, seed=5, size=SIZE):
@@ -125,6 +135,7 @@ def area_lobe_inputs(kind, seed=5, size=SIZE):
     r = rng.random(count)
     r[:6] = [0.0, 1.0, 0.0, 1.0, 0.5, 1e-3]
     vals = {"Position": p, "N": n, "V": v, "Roughness": r, "Wrap": rng.random(count)}
+    vals["Diffuse Roughness"] = _diffuse_roughness(rng, count)
     if kind == "quad":
         corners = [center - u - w, center + u - w, center + u + w, center - u + w]
         vals.update({f"p{i}": c for i, c in enumerate(corners)})
@@ -282,6 +293,7 @@ def world_inputs(seed=5, size=SIZE):
     for i in range(9):
         vals[f"SH {i}"] = np.broadcast_to(coeffs[i], shape + (3,)).copy()
         vals[f"World SH {i}"] = vals[f"SH {i}"]
+    vals["Diffuse Roughness"] = _diffuse_roughness(rng, shape)
     return {k: np.asarray(a, np.float32) for k, a in vals.items()}
 
 

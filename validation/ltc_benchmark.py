@@ -79,9 +79,11 @@ def magnitude_check(ltc_mag, published_mag, n_ref):
     return out
 
 
-def fit_quality(tables, published, n_tv, out_dir):
+def fit_quality(tables, published, n_tv, out_dir, prefixes=None):
     out = {}
     for prefix, (lobe_name, _) in catalog.LTC_LOBES.items():
+        if prefixes is not None and prefix not in prefixes:
+            continue
         packed = tables[prefix + "_inv"].astype(np.float64)
         mag = tables[prefix + "_mag"][..., 0].astype(np.float64)
         tv = tv_map(lobe_name, packed, mag, n_tv)
@@ -202,9 +204,11 @@ def _stats(est, truth, albedo, theta):
     return out
 
 
-def end_to_end(tables, published, n_quads, n_disks, seed=2019):
+def end_to_end(tables, published, n_quads, n_disks, seed=2019, prefixes=None):
     results = {}
     for prefix, (lobe_name, _) in catalog.LTC_LOBES.items():
+        if prefixes is not None and prefix not in prefixes:
+            continue
         lobe = lobes.LOBES[lobe_name]
         sphere = tables[prefix + "_mag"][..., 3]
         for kind, count in (("quad", n_quads), ("disk", n_disks)):
@@ -354,6 +358,9 @@ def parse_args(argv):
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--quick", action="store_true", help="small sets, no bake timing (smoke run)")
     p.add_argument("--skip-bake", action="store_true", help="do not time the bake")
+    p.add_argument("--lobes", nargs="+", default=None, choices=[lobe for lobe, _ in catalog.LTC_LOBES.values()],
+                   help="only these lobes' tables (fit error and random lights; the rough diffuse's area forms with "
+                        "oren_nayar), written to ltc_<lobes>.md / .json; ltc.md is left alone")
     return p.parse_args(argv)
 
 
@@ -365,6 +372,8 @@ def run(args, log=report.flush_log):
     from . import published_ltc as ltc_anchor
 
     res = {"machine": f"{platform.machine()}, {os.cpu_count()} cores", "date": time.strftime("%Y-%m-%d")}
+    if getattr(args, "lobes", None):
+        return run_lobes(args, res, log)
     status = catalog.lut_status(args.lut_dir)
     if any(s.state != "ok" for s in status):
         log("[bench] baking the LUTs first")
@@ -399,3 +408,104 @@ def exr_io_read(lut_dir, name):
 
     spec = catalog.TABLES[name]
     return exr_io.read_table(Path(lut_dir) / spec.filename, spec.name, spec.shape)[0].astype(np.float64)
+
+
+# --- one lobe's tables (--lobes) and the rough diffuse's area forms -------------------------------------------
+
+def rough_diffuse_area_forms(tables, n_quads, n_disks, seed=2024):
+    """The rough diffuse (core/rough_diffuse.py) under random lights against brute force: its multiple-scattering
+    kernel over the light as shipped (Lambert form factor x its ratio towards the light's centre) and through the
+    fixed LTC fitted to it (``rough_diffuse.MS_KERNEL_LTC``), and the whole lobe at albedo 1 as RT Lit computes it
+    (``lobes.OREN_NAYAR``: the single scattering's LTC x the closed-form albedo, plus the kernel's share)."""
+    from ..core import rough_diffuse as rd
+    from ..core.materials import lobes as rt_lobes
+
+    luts = lookup.LutSet.from_folder(tables["lut_dir"])
+    sphere = tables["ltc_ggx_mag"][..., 3]
+    results = {}
+    for kind, count in (("quad", n_quads), ("disk", n_disks)):
+        fn = rt_lobes.OREN_NAYAR.function(kind)
+        rows = {k: [] for k in ("centre", "ltc", "ms_truth", "ms_albedo", "total", "total_truth", "albedo", "theta")}
+        for r, theta, v, geom in random_lights(kind, count, "oren_nayar", seed):
+            mu = float(v[2])
+            ms_truth, _ = _truth(kind, lambda l, vv, r=r: rd.multiscatter_cos(l[..., 2], vv[..., 2], r), v, geom)
+            ss_truth, _ = _truth(kind, lambda l, vv, r=r: rd.fon_single_scatter_cos(
+                l[..., 2], vv[..., 2], np.sum(l * vv, axis=-1), r), v, geom)
+            light = ({**{f"p{i}": geom[i] for i in range(4)}, "Center": geom.mean(axis=0)} if kind == "quad"
+                     else {"Center": geom[0], "Axis U": geom[1], "Axis V": geom[2]})
+            out = fn(luts, Position=np.zeros(3), N=np.array([0.0, 0.0, 1.0]), V=v, **light,
+                     **{"Diffuse Roughness": np.float64(r)})
+            c = rd.MS_KERNEL_LTC
+            fixed = (polygon.ltc_polygon_integral_packed(c, list(geom), False, sphere) if kind == "quad"
+                     else disk.ltc_disk_integral_packed(c, *geom, False, sphere))
+            rows["centre"].append(float(out["Diffuse MS"]))
+            rows["ltc"].append(float(fixed) * float(rd.fon_one_minus_albedo(mu, r)))
+            rows["ms_truth"].append(ms_truth)
+            rows["total"].append(float(out["Diffuse"]) + float(out["Diffuse MS"]))
+            rows["total_truth"].append(ss_truth + ms_truth)
+            rows["ms_albedo"].append(float(rd.fon_one_minus_albedo(mu, r)))
+            rows["albedo"].append(1.0)
+            rows["theta"].append(theta)
+        ms = (rows["ms_truth"], rows["ms_albedo"], rows["theta"])
+        results[kind] = {"ms_centre": _stats(rows["centre"], *ms), "ms_fixed_ltc": _stats(rows["ltc"], *ms),
+                         "total": _stats(rows["total"], rows["total_truth"], rows["albedo"], rows["theta"])}
+    return results
+
+
+def run_lobes(args, res, log=report.flush_log):
+    """``--lobes``: the fit error and random-light error of the named lobes' tables (and the rough diffuse's
+    area forms), into ltc_<lobes>.md / .json; the other tables' ltc.md is not touched."""
+    prefixes = [p for p, (lobe, _) in catalog.LTC_LOBES.items() if lobe in args.lobes]
+    status = [s for s in catalog.lut_status(args.lut_dir) if s.name.startswith(tuple(prefixes))]
+    if any(s.state != "ok" for s in status):
+        log("[bench] baking the LUTs first")
+        bake.bake(args.lut_dir, groups=prefixes + ["ltc_ggx"])
+    tables = {name: exr_io_read(args.lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}
+    tables["lut_dir"] = args.lut_dir
+    log(f"[bench] lobe error per cell ({', '.join(args.lobes)}) ...")
+    res["fit_quality"] = fit_quality(tables, None, 1 << (10 if args.quick else 12), args.out, prefixes)
+    log("[bench] end-to-end random lights ...")
+    res["end_to_end"] = end_to_end(tables, None, 60 if args.quick else 600, 30 if args.quick else 300,
+                                   prefixes=prefixes)
+    if "oren_nayar" in args.lobes:
+        log("[bench] the rough diffuse's area forms ...")
+        res["rough_diffuse"] = rough_diffuse_area_forms(tables, 60 if args.quick else 300, 30 if args.quick else 150)
+    stem = "ltc_" + "_".join(args.lobes)
+    (args.out / f"{stem}.json").write_text(json.dumps(res, indent=2, default=report.json_default))
+    write_lobes_markdown(res, args.out / f"{stem}.md", args)
+    log((args.out / f"{stem}.md").read_text())
+    return res
+
+
+def write_lobes_markdown(res, path, args):
+    lines = [f"# LTC fit and accuracy: {', '.join(args.lobes)}", "",
+             f"Command: `python scripts/benchmark_ltc.py --lobes {' '.join(args.lobes)}` ({res['machine']}, "
+             f"{res['date']}). The same measurements as ltc.md (which has the other tables), for these lobes; "
+             "ground truth: brute-force BRDF x cos over the light (core/ltc/reference.py).", "",
+             "## Lobe error per table cell (total-variation distance, 0 = identical)", "",
+             "| lobe | mean | p90 | max |", "|---|---|---|---|"]
+    for name, q in res["fit_quality"].items():
+        lines.append(f"| {name} | {q['tv_mean']:.4f} | {q['tv_p90']:.4f} | {q['tv_max']:.4f} |")
+    lines += ["", "Heat maps (u = roughness, v = sqrt(1 - mu), colour 0..0.3): "
+              + ", ".join(f"`ltc_tv_{n}.png`" for n in res["fit_quality"]) + ".", "",
+              "## End-to-end error on random lights (the table's LTC x its magnitude)", "",
+              "Relative error on lights carrying > 10% of the lobe's albedo; absolute error as a fraction of the albedo "
+              "on all lights.", "",
+              "| lobe / light | n (>10%) | rel median | rel p90 | rel max | abs/albedo median | abs/albedo p90 |",
+              "|---|---|---|---|---|---|---|"]
+    for key, e in res["end_to_end"].items():
+        lines.append(f"| {key} | {_fmt_stats(e['ours'])}")
+    rd = res.get("rough_diffuse")
+    if rd:
+        lines += ["", "## The rough diffuse over the light (core/materials/lobes.py, albedo 1)", "",
+                  "The multiple-scattering kernel over the light as RT Lit integrates it (the Lambert form factor x "
+                  "the kernel's ratio to the cosine towards the light's centre) and through the fixed LTC fitted to "
+                  "the kernel (rough_diffuse.MS_KERNEL_LTC; its albedo is 1 - E_F(mu_v)), and the whole lobe "
+                  "(single + multiple scattering, albedo 1) against the brute force of both.", "",
+                  "| part / light | n (>10%) | rel median | rel p90 | rel max | abs/albedo median | abs/albedo p90 |",
+                  "|---|---|---|---|---|---|---|"]
+        for kind, e in rd.items():
+            lines.append(f"| multiple scattering, centre form (shipped) / {kind} | {_fmt_stats(e['ms_centre'])}")
+            lines.append(f"| multiple scattering, fixed LTC / {kind} | {_fmt_stats(e['ms_fixed_ltc'])}")
+            lines.append(f"| whole lobe / {kind} | {_fmt_stats(e['total'])}")
+    path.write_text("\n".join(lines) + "\n")

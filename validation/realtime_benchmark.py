@@ -153,6 +153,7 @@ def write_scene(folder, features, world, count, resolution, lut_dir):
               "Specular Tint": [1.0, 1.0, 1.0], "Wrap": 0.3, "Sheen Weight": 0.5, "Sheen Tint": [1.0, 1.0, 1.0],
               "Cloth Weight": 0.3, "Cloth Color": [0.9, 0.7, 0.8], "Emission Color": [1.0, 1.0, 1.0],
               "Emission Strength": 0.0, "Normal": [0.0, 0.0, 0.0]}
+    inputs["Diffuse Roughness"] = 0.6
     mat = scene_io.SceneMaterial("benchmark", features.as_dict(), inputs)
     positions, normals = uv_sphere()
     obj = scene_io.SceneObject("sphere", "benchmark", "0", len(positions) // 3)

@@ -85,6 +85,17 @@ TECHNIQUES = {
 MIX_METALLIC = 0.5
 
 
+#: The rough diffuse (core/rough_diffuse.py) against Cycles' own: the Diffuse BSDF with Roughness sigma is the
+#: closure Principled's Diffuse Roughness makes (the same Oren-Nayar, measured: scripts/validate_rough_diffuse.py).
+#: Beside it the talk's CoD diffuse against the same reference, its Roughness set to sigma: what to pick.
+TECHNIQUES["oren_nayar"] = (Features("none", "oren_nayar"), "cycles",
+                            "rough diffuse (Fujii + EON, as Cycles) vs Cycles Diffuse BSDF with Roughness sigma")
+TECHNIQUES["cod_cycles"] = (Features("none", "cod"), "cycles",
+                            "CoD WWII diffuse with Roughness = sigma vs Cycles Diffuse BSDF with Roughness sigma")
+#: Base colour of the rough-diffuse variants (the multiple scattering's colour is non-linear in it).
+ROUGH_DIFFUSE_COLOR = (0.8, 0.55, 0.3)
+
+
 def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
     """RT Lit input values of a variant (the inputs not given keep RT_LIT_INPUTS' defaults).  The diffuse,
     cloth and sheen techniques are built without specular (``TECHNIQUES``: specular "none"); Metallic 1
@@ -108,6 +119,8 @@ def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
         m.update({"Metallic": 1.0, "Cloth Weight": 1.0, "Cloth Color": color or WHITE})
     elif technique == "sheen":
         m.update({"Metallic": 1.0, "Sheen Weight": 1.0, "Sheen Tint": color or WHITE})
+    elif technique in ("oren_nayar", "cod_cycles"):
+        m.update({"Base Color": color or ROUGH_DIFFUSE_COLOR, "Diffuse Roughness": float(roughness)})
     else:
         raise ValueError(f"unknown technique {technique!r}")
     return m
@@ -309,7 +322,24 @@ def build_cases(seed=0, quick=False):
         cases.append(Case(f"metallic_mix_{spec.kind}", [spec], mix_row, columns=3,
                           description=f"{spec.describe()}: Turquin, Fdez-Aguera, Kulla-Conty (rows) at Metallic 0.5, "
                                       "r = 0.3, 0.6, 0.9", tags={"light": spec.kind}))
+    cases += rough_diffuse_cases(cases)
     return cases
+
+
+def rough_diffuse_cases(cases):
+    """The rough diffuse and CoD against Cycles' Diffuse BSDF with Roughness sigma, under the lights of two quad,
+    two disk and the point, spot and sun cases of ``cases`` (the same light objects)."""
+    row = ([Variant("oren_nayar", r) for r in (0.3, 0.6, 1.0)] + [Variant("cod_cycles", r) for r in (0.3, 0.6, 1.0)])
+    out = []
+    for case in cases:
+        if case.name in ("quad0_closures", "quad1_closures", "disk4_closures", "disk5_closures", "point", "spot",
+                         "sun"):
+            name = case.name.replace("_closures", "")
+            out.append(Case(f"{name}_rough_diffuse", case.lights, row, columns=3,
+                            description=f"{case.lights[0].describe()}: Oren-Nayar (top) and CoD (bottom), "
+                                        "sigma = 0.3, 0.6, 1, vs Cycles' rough Diffuse BSDF",
+                            tags=dict(case.tags, rough_diffuse=True)))
+    return out
 
 
 # --- scene ------------------------------------------------------------------------------------
@@ -514,6 +544,9 @@ def _closure_material(variant, name):
 
     if t == "lambert":
         shader = diffuse(m["Base Color"])
+    elif t in ("oren_nayar", "cod_cycles"):
+        shader = diffuse(m["Base Color"])
+        shader.inputs["Roughness"].default_value = m["Diffuse Roughness"]
     elif t == "ggx":
         shader = glossy("GGX")
     elif t in ("turquin", "fdez_aguera", "kulla_conty_white"):

@@ -70,6 +70,19 @@ TECHNIQUES = {
                     "Kulla-Conty split sum + F_ms (1 - E) I, F0 = 1, vs Multiscatter GGX"),
 }
 MULTISCATTER = ("turquin", "fdez_aguera", "fdez_aguera_radiance", "kulla_conty")
+#: The rough diffuse and CoD against Cycles' Diffuse BSDF with Roughness sigma (closure "ROUGH_DIFFUSE", sigma):
+#: the same references as under the lights (suite_cases "oren_nayar" / "cod_cycles"), white.
+TECHNIQUES["oren_nayar"] = (Features("none", "oren_nayar"), "ROUGH_DIFFUSE",
+                            "rough diffuse (Fujii + EON, SH-LTC + exact SH multiple scattering) vs Cycles Diffuse BSDF "
+                            "with Roughness sigma")
+TECHNIQUES["cod_cycles"] = (Features("none", "cod"), "ROUGH_DIFFUSE",
+                            "CoD WWII diffuse (SH-LTC) with Roughness = sigma vs Cycles Diffuse BSDF with Roughness sigma")
+ROUGH_DIFFUSE_ROUGHNESS = (0.5, 1.0)
+
+
+def rough_diffuse_variants():
+    """The rough diffuse and CoD rows (``node_variants(rough_diffuse=True)``)."""
+    return [WorldVariant(t, r) for t in ("oren_nayar", "cod_cycles") for r in ROUGH_DIFFUSE_ROUGHNESS]
 
 
 def technique_material(technique, roughness):
@@ -77,6 +90,8 @@ def technique_material(technique, roughness):
     specular: ``TECHNIQUES``), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
     from . import suite_cases as suite
 
+    if technique in ("oren_nayar", "cod_cycles"):
+        return suite.technique_material(technique, roughness, suite.WHITE)
     base = technique if technique in ("lambert", "cod", "cod_wrapped") else "ggx"
     return suite.technique_material(base, roughness)
 
@@ -122,8 +137,9 @@ class WorldSpec:
         return s
 
 
-def node_variants(quick=False, kulla_conty=True):
-    """The node block: Lambert, then one row per technique over the roughness sweep."""
+def node_variants(quick=False, kulla_conty=True, rough_diffuse=False):
+    """The node block: Lambert, then one row per technique over the roughness sweep (``rough_diffuse``: then the
+    rough-diffuse rows)."""
     rough = (0.25, 0.75) if quick else SPECULAR_ROUGHNESS
     out = [WorldVariant("lambert")]
     techs = ["cod", "ggx", "turquin", "fdez_aguera", "fdez_aguera_radiance"]
@@ -131,7 +147,7 @@ def node_variants(quick=False, kulla_conty=True):
         techs += ["kulla_conty", "cod_wrapped"]
     for t in techs:
         out += [WorldVariant(t, r) for r in rough]
-    return out
+    return out + (rough_diffuse_variants() if rough_diffuse else [])
 
 
 def furnace_variants(quick=False):
@@ -261,8 +277,9 @@ def closure_material(closure, name):
     from . import suite_cases as suite
 
     kind, r = closure
-    technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin"}[kind]
-    return suite._closure_material(suite.Variant(technique, r), name)
+    technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin", "ROUGH_DIFFUSE": "oren_nayar"}[kind]
+    color = suite.WHITE if kind == "ROUGH_DIFFUSE" else None        # white, as the node block's variants
+    return suite._closure_material(suite.Variant(technique, r, color), name)
 
 
 def new_scene():

@@ -44,6 +44,8 @@ err_ab.png}; the bakes in <out>/env_cache (``--cache``).
 Usage:
     python scripts/validate_world.py [--quick] [--hdri NAME ...] [--out DIR] [--samples 768] [--cell 32]
     blender --background --python scripts/validate_world.py -- [same options]   (needs OpenEXR importable)
+    python scripts/validate_world.py --rough-diffuse only   (the rough diffuse and CoD vs Cycles' rough Diffuse
+                                                             BSDF, docs/rough_diffuse.md; "add": beside the rest)
 Full run: 7-9 minutes on 2 cores (521 s measured with other jobs on the machine; about 6 min with
 --samples 512); --quick (one rotated HDRI, few spheres, 256 spp): about 22 s.
 """
@@ -921,6 +923,9 @@ def parse_args(argv):
                    help="do not force a bake per HDRI to time it")
     p.add_argument("--cache", default=None, help="bake cache folder (default <out>/env_cache)")
     p.add_argument("--lut-dir", default=None)
+    p.add_argument("--rough-diffuse", choices=("off", "add", "only"), default="off",
+                   help="the rough diffuse (Oren-Nayar) and CoD vs Cycles' rough Diffuse BSDF: added to the node "
+                        "block, or the only rows besides Lambert")
     for k, v in DEFAULTS.items():
         p.add_argument("--" + k.replace("_", "-"), type=float, default=v)
     args = p.parse_args(argv)
@@ -994,6 +999,9 @@ def _run_worlds(args, out_dir, rng, tables, log):
     for spec in worlds_of(args):
         rotated = any(spec.rotation) or spec.strength != 1.0
         variants = vw.node_variants(quick=args.quick or rotated, kulla_conty=not args.quick)
+        if getattr(args, "rough_diffuse", "off") != "off":
+            keep = [v for v in variants if v.technique == "lambert"] if args.rough_diffuse == "only" else variants
+            variants = keep + vw.rough_diffuse_variants()
         r, p = run_world(spec, variants, args, out_dir, rng, tables, log,
                          bake_timing=args.bake_timing and not (rotated and not args.quick))
         worlds.append(r)

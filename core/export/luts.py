@@ -63,6 +63,9 @@ CITATIONS = {
     "sphere": ["Snyder 1996, Area Light Sources for Real-Time Graphics (MSR-TR-96-11)",
                "Hill & Heitz 2017, LTC: clipless horizon handling with the sphere table"],
 }
+#: The rough-diffuse LTC pair's lobe (core/rough_diffuse.py).
+CITATIONS["oren_nayar"] = ["Fujii, A tiny improvement of Oren-Nayar reflectance model (improved Oren-Nayar)",
+                           "Portsmouth, Kutz & Hill 2025, EON: A Practical Energy-Preserving Rough Diffuse BRDF (JCGT 14(1))"]
 
 
 class LutExportError(RuntimeError):
@@ -91,6 +94,9 @@ class ExportTable:
 def _axes(spec):
     w, h = spec.width, spec.height
     u = {"parameter": "r (Blender roughness; GGX alpha = max(r^2, 1e-4))", "nodes": w, "node": "r = i / (W - 1)"}
+    if spec.axis_u == catalog.AXIS_U_DIFFUSE_ROUGHNESS:
+        u = {"parameter": "sigma (diffuse roughness: Principled's Diffuse Roughness)", "nodes": w,
+             "node": "sigma = i / (W - 1)"}
     if spec.height == 1:
         v = {"parameter": "none (one row)", "nodes": 1, "node": "sample at v = 0.5"}
     elif spec.axis_v == catalog.AXIS_V_SQRT_ONE_MINUS_MU:
@@ -111,7 +117,8 @@ def _catalog_table(luts, name, export_name=None):
     spec = catalog.TABLES[name]
     kind = "ltc" if name.startswith("ltc_") else "energy"
     return ExportTable(export_name or name, name, luts.array(name).astype(np.float32), spec.channels,
-                       spec.description, _axes(spec), CITATIONS[kind] + (CITATIONS["sphere"] if name.endswith("_mag") else []),
+                       spec.description, _axes(spec), CITATIONS[kind] + (CITATIONS["sphere"] if name.endswith("_mag") else [])
+                       + (CITATIONS["oren_nayar"] if name.startswith("ltc_oren_nayar") else []),
                        _origin(luts[name].source))
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import cloth, diffuse, microfacet
+from .. import cloth, diffuse, microfacet, rough_diffuse
 from ..conventions import alpha_from_roughness
 
 
@@ -112,8 +112,17 @@ class ClothLobe(Lobe):
         return np.where(l[..., 2] > 0, 0.5 / np.pi, 0.0)
 
 
+class OrenNayarLobe(CodDiffuseLobe):
+    """Fujii's improved Oren-Nayar single scattering, albedo 1 (core.rough_diffuse); r is the diffuse roughness
+    sigma.  Cosine sampling, as the CoD lobe (both are close to a cosine)."""
+
+    def eval_cos(self, l, v, r):
+        return rough_diffuse.fon_single_scatter_cos(l[..., 2], v[..., 2], np.sum(l * v, axis=-1), r)
+
+
 LOBES = {
     "ggx": GGXLobe("ggx", "single-scattering GGX, height-correlated Smith G2, F = 1"),
     "cod_diffuse": CodDiffuseLobe("cod_diffuse", "Call of Duty WWII multiscattering diffuse (Chan 2018), albedo 1"),
     "cloth": ClothLobe("cloth", "Ashikhmin velvet + Neubelt-Pettineo visibility (cloth), colour 1"),
+    "oren_nayar": OrenNayarLobe("oren_nayar", "Fujii's improved Oren-Nayar single scattering, albedo 1"),
 }

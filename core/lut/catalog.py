@@ -17,7 +17,7 @@ import hashlib
 import io
 import json
 import tokenize
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from . import exr_io
@@ -86,13 +86,15 @@ _LTC_SOURCES = ("core/ltc/fit.py", "core/ltc/fit_lobes.py", "core/ltc/matrix.py"
                 "core/ltc/sphere_table.py", "core/microfacet.py", "core/sampling.py", "core/conventions.py",
                 "core/shading_ops.py", "core/ir/semantics.py", "core/lut_bake.py")
 #: The module of each LTC lobe's BRDF beyond GGX (only its own group depends on it).
-_LTC_BRDF_SOURCES = {"ltc_cod_diffuse": ("core/diffuse.py",), "ltc_cloth": ("core/cloth.py",)}
+_LTC_BRDF_SOURCES = {"ltc_cod_diffuse": ("core/diffuse.py",), "ltc_cloth": ("core/cloth.py",),
+                     "ltc_oren_nayar": ("core/rough_diffuse.py",)}
 
 #: LTC lobes: table prefix -> (lobe name in core.ltc.fit_lobes, description)
 LTC_LOBES = {
     "ltc_ggx": ("ggx", "single-scattering GGX (F = 1, height-correlated Smith G2)"),
     "ltc_cod_diffuse": ("cod_diffuse", "Call of Duty WWII multiscattering diffuse (albedo 1)"),
     "ltc_cloth": ("cloth", "Ashikhmin velvet + Neubelt-Pettineo visibility (colour 1)"),
+    "ltc_oren_nayar": ("oren_nayar", "Fujii's improved Oren-Nayar single scattering (albedo 1)"),
 }
 
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
@@ -137,6 +139,12 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
         name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
         channels=LTC_MAG_CHANNELS, description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
+
+#: The rough-diffuse table's u axis is the diffuse roughness (Principled "Diffuse Roughness"), not the GGX one.
+AXIS_U_DIFFUSE_ROUGHNESS = ("u: diffuse roughness sigma (Principled \"Diffuse Roughness\", Fujii's sigma); node i at "
+                            "sigma = i/(W-1), texel centre (i+0.5)/W")
+for _name in ("ltc_oren_nayar_inv", "ltc_oren_nayar_mag"):
+    TABLES[_name] = replace(TABLES[_name], axis_u=AXIS_U_DIFFUSE_ROUGHNESS)
 
 _PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 

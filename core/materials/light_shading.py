@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import functools
 
-from .. import lights, multiscatter
+from .. import lights, multiscatter, rough_diffuse
 from .. import shading_ops as op
 from ..fresnel import fresnel_average
 from ..ir.functions import NodeFunction
@@ -73,6 +73,8 @@ def combine_lobes(features, surface, lobe_values, light_color, area=False):
         w = surface["Cloth Weight"]
         spec = op.scale(spec, 1.0 - w) + op.scale(cloth, w)
     total = spec + op.scale(surface["Albedo"], lobe_values["Diffuse"])
+    if features.diffuse == "oren_nayar":
+        total = total + _rough_diffuse_multiscatter(surface, lobe_values)
     if features.sheen:
         total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
     return op.vmul(light_color, total)
@@ -82,11 +84,20 @@ def _without_specular(features, surface, lobe_values, light_color):
     """``combine_lobes`` with the specular switched off: the cloth lobe still blends in by Cloth Weight
     (over no specular), the diffuse and sheen add."""
     total = op.scale(surface["Albedo"], lobe_values["Diffuse"])
+    if features.diffuse == "oren_nayar":
+        total = total + _rough_diffuse_multiscatter(surface, lobe_values)
     if features.cloth:
         total = total + op.scale(op.scale(surface["Cloth Color"], lobe_values["Cloth"]), surface["Cloth Weight"])
     if features.sheen:
         total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
     return op.vmul(light_color, total)
+
+
+def _rough_diffuse_multiscatter(surface, lobe_values):
+    """The rough diffuse's multiple-scattering lobe in colour: Cycles' albedo x rho_ms(base colour) per channel
+    (core/rough_diffuse.py; Principled's diffuse weight is base x (1 - metallic), its lobe colour the base)."""
+    color = rough_diffuse.multiscatter_color(surface["Albedo"], surface["Metal F0"], surface["Diffuse Roughness"])
+    return op.scale(color, lobe_values["Diffuse MS"])
 
 
 def lobe_keys(features):
@@ -105,16 +116,23 @@ def lobe_keys(features):
 SHADE_SURFACE = ("N", "V", "Roughness", "F0", "Albedo", "Wrap", "Sheen Color", "Cloth Weight", "Cloth Color")
 #: What the split specular models read instead of the mixed F0.
 SPLIT_F0_SURFACE = ("Dielectric F0", "Metal F0", "Metallic")
+#: ... and those the rough diffuse adds (only groups built with it read them).
+ROUGH_DIFFUSE_SURFACE = ("Diffuse Roughness", "Metal F0")
 
 
 def shade_surface(features):
     """The surface terms one light's shading reads with ``features``: the mixed F0, or the dielectric and
-    metal F0 and Metallic for the models that shade them apart (``SPLIT_F0_MODELS``), no F0 without specular."""
+    metal F0 and Metallic for the models that shade them apart (``SPLIT_F0_MODELS``), no F0 without specular;
+    the rough diffuse's inputs with it."""
     if features.specular == "none":
-        return tuple(k for k in SHADE_SURFACE if k != "F0")
-    if features.specular not in SPLIT_F0_MODELS:
-        return SHADE_SURFACE
-    return tuple(k for k in SHADE_SURFACE if k != "F0") + SPLIT_F0_SURFACE
+        terms = tuple(k for k in SHADE_SURFACE if k != "F0")
+    elif features.specular not in SPLIT_F0_MODELS:
+        terms = SHADE_SURFACE
+    else:
+        terms = tuple(k for k in SHADE_SURFACE if k != "F0") + SPLIT_F0_SURFACE
+    if features.diffuse == "oren_nayar":
+        terms += tuple(k for k in ROUGH_DIFFUSE_SURFACE if k not in terms)
+    return terms
 
 
 def light_color_name(kind):

@@ -22,6 +22,9 @@ from ..ir.interface import Socket, color, factor, scalar, vector
 SPECULAR_MODELS = ("single", "turquin", "fdez_aguera", "kulla_conty", "none")
 #: "cod_wrapped": the CoD multiscattering diffuse with the Wrap input (the talk's multiscattering wrapped diffuse).
 DIFFUSE_MODELS = ("lambert", "cod", "wrapped", "cod_wrapped")
+#: "oren_nayar": rough diffuse as Cycles shades Principled's Diffuse Roughness (Fujii's improved Oren-Nayar with
+#: EON's energy-preserving multiple scattering; core/rough_diffuse.py), read from the "Diffuse Roughness" input.
+DIFFUSE_MODELS += ("oren_nayar",)
 #: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
 #: the prefiltered radiance (the talk's approximation); core/materials/world.py.
 ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")
@@ -39,6 +42,8 @@ RT_LIT_INPUTS = {
     "Specular Tint": color((1.0, 1.0, 1.0, 1.0), "Tint of the dielectric F0", "Specular"),
     "Wrap": factor(0.0, "Wrapped-diffuse amount w (used by the 'wrapped' and 'cod_wrapped' diffuse models)",
                    "Diffuse"),
+    "Diffuse Roughness": factor(0.0, "Oren-Nayar roughness sigma, as Principled's Diffuse Roughness (used when the "
+                                     "diffuse model is 'oren_nayar')", "Diffuse"),
     "Sheen Weight": factor(0.0, "Disney sheen amount (used when sheen is switched on)", "Sheen"),
     "Sheen Tint": color((1.0, 1.0, 1.0, 1.0), "Colour of the Disney sheen", "Sheen"),
     "Cloth Weight": factor(0.0, "Blend from the specular lobe to the Ashikhmin cloth lobe (cloth switched on)",
@@ -69,6 +74,7 @@ SURFACE_OUTPUTS = {
     "Metallic": factor(0.0, "Blend from dielectric to metal"),
     "Albedo": color((0.8, 0.8, 0.8), "Diffuse albedo"),
     "Wrap": factor(0.0, "Wrapped-diffuse amount"),
+    "Diffuse Roughness": factor(0.0, "Diffuse (Oren-Nayar) roughness sigma"),
     "Sheen Color": color((0.0, 0.0, 0.0), "Sheen weight times tint"),
     "Cloth Weight": factor(0.0, "Blend from specular to cloth"),
     "Cloth Color": color((1.0, 1.0, 1.0), "Cloth colour"),

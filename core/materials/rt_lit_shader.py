@@ -118,7 +118,9 @@ class MaterialShader:
         for name, sock in RT_LIT_INPUTS.items():
             if name in _VARYING_INPUTS:
                 continue
-            value = material_values[name]
+            # an input the material does not name (a scene description written before the input existed, e.g.
+            # "Diffuse Roughness") takes its socket's default, as an unlinked node socket would
+            value = material_values.get(name, sock.default)
             out[_material_uniform(name)] = float(value) if sock.kind == "float" else tuple(float(v) for v in value[:3])
         if len(lights_values) != len(self.light_slots):
             raise ValueError(f"{self.material.name}: {len(lights_values)} lights given, the shader was built for "

@@ -60,6 +60,7 @@ def _surface(**kw):
         "F0": f0,
         "Albedo": op.scale(base, 1.0 - metallic),
         "Wrap": op.saturate(kw["Wrap"]),
+        "Diffuse Roughness": op.saturate(kw["Diffuse Roughness"]),
         "Sheen Color": op.scale(_reflectance(kw["Sheen Tint"]), op.saturate(kw["Sheen Weight"])),
         "Cloth Weight": op.saturate(kw["Cloth Weight"]),
         "Cloth Color": _reflectance(kw["Cloth Color"]),

@@ -489,3 +489,30 @@ def test_switches_in_the_panel_rebuild_the_group(bpy_module, empty_scene, lut_di
         assert (switches.specular, switches.sheen) == ("kulla_conty", True)
     finally:
         addon.unregister()
+
+
+def test_diffuse_roughness_maps_both_ways_and_is_proposed(bpy_module, convert, factory):
+    """Principled's Diffuse Roughness: the dialog proposes the Oren-Nayar diffuse for it, the value maps to RT Lit's
+    input and back, and another diffuse model says it is not shaded."""
+    from rt_lookdev.addon import compat
+
+    mat = compat.new_material("Clay")
+    principled = mat.node_tree.nodes["Principled BSDF"]
+    assert not convert.principled_uses_diffuse_roughness(mat)          # Blender's default: 0
+    principled.inputs["Diffuse Roughness"].default_value = 0.65
+    assert convert.principled_uses_diffuse_roughness(mat)
+    assert "Diffuse Roughness" in convert.MAPPED_INPUTS
+
+    result = convert.principled_to_rt_lit(mat, factory, Features("turquin", "oren_nayar"))
+    rt = mat.node_tree.nodes["RT Lit"]
+    assert rt.inputs["Diffuse Roughness"].default_value == pytest.approx(0.65)
+    assert not result.ignored_inputs and not any("Diffuse Roughness" in w for w in result.warnings)
+    rt.inputs["Diffuse Roughness"].default_value = 0.3                    # edited in RT Lit
+    back = convert.rt_lit_to_principled(mat)
+    assert back.status == "converted"
+    assert mat.node_tree.nodes["Principled BSDF"].inputs["Diffuse Roughness"].default_value == pytest.approx(0.3)
+
+    # another diffuse model: converted, with the roughness kept on the node and a warning that it is not shaded
+    result = convert.principled_to_rt_lit(mat, factory, Features("turquin", "cod"))
+    assert mat.node_tree.nodes["RT Lit"].inputs["Diffuse Roughness"].default_value == pytest.approx(0.3)
+    assert any("Diffuse Roughness 0.3 is not shaded" in w and "Oren-Nayar" in w for w in result.warnings)

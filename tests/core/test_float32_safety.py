@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from rt_lookdev.core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter
+from rt_lookdev.core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter, rough_diffuse
 
 F = np.float32
 COS = np.array([-1.0, -1e-7, 0.0, 1e-7, 0.5, 1.0 - 1e-7, 1.0], dtype=F)
@@ -29,6 +29,14 @@ CASES = {
     "cone_falloff": lambda: falloff.cone_falloff(*grid(COS, UNIT * F(3.1), UNIT * F(3.1))),
     "projector_distance": lambda: falloff.projector_distance(*grid(UNIT, UNIT * F(3.1))),
 }
+CASES.update({
+    "fon_single_scatter_cos": lambda: rough_diffuse.fon_single_scatter_cos(*grid(COS, COS, COS, UNIT)),
+    "rough_diffuse_multiscatter_cos": lambda: rough_diffuse.multiscatter_cos(*grid(COS, COS, UNIT)),
+    "fon_albedo": lambda: rough_diffuse.fon_albedo(*grid(COS, UNIT)),
+    "fon_one_minus_albedo": lambda: rough_diffuse.fon_one_minus_albedo(*grid(COS, UNIT)),
+    "fon_average_albedo": lambda: rough_diffuse.fon_average_albedo(UNIT),
+    "rough_diffuse_multiscatter_albedo": lambda: rough_diffuse.multiscatter_albedo(*grid(UNIT, UNIT)),
+})
 
 
 @pytest.mark.parametrize("name", sorted(CASES))

@@ -35,7 +35,7 @@ def test_every_library_function_compiles(glslang_path, dialect):
     from rt_lookdev.node_groups import library
 
     functions = list(library.all_functions()) + [world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD,
-                                                 world.SH_LTC_CLOTH, world.SH_LTC_SHEEN]
+                                                 world.SH_LTC_CLOTH, world.SH_LTC_SHEEN, world.SH_LTC_OREN_NAYAR]
     for fn in functions:
         module = _compile_function(fn, dialect)
         # readable output: one function per node function, named after it, with its description
@@ -52,6 +52,9 @@ MATERIALS = {
     "minimal: single + Lambert, one point, no world": (dict(specular="single", diffuse="lambert"), ("point",), False),
     "no lights, world only": (dict(specular="turquin", diffuse="cod", sheen=True), (), True),
 }
+#: The rough diffuse (Oren-Nayar as Cycles): every light kind and the world.
+MATERIALS["turquin + Oren-Nayar, every light kind, world"] = (dict(specular="turquin", diffuse="oren_nayar"),
+                                                             ("quad", "disk", "point", "spot", "sun"), True)
 
 
 @pytest.fixture(scope="module")
