@@ -188,6 +188,8 @@ def _stats(est, truth, albedo, theta):
     rel_sel = truth > 0.1 * albedo
     rel = np.abs(est - truth)[rel_sel] / truth[rel_sel]
     absn = np.abs(est - truth) / albedo
+    if rel.size == 0:                # no light carries 10% of the albedo (a few lights, a grazing lobe)
+        rel = np.array([np.nan])
     out = {"lights": int(truth.size), "lights_over_10pct": int(rel_sel.sum()),
            "rel_median": float(np.median(rel)), "rel_p90": float(np.quantile(rel, 0.9)), "rel_max": float(rel.max()),
            "abs_over_albedo_median": float(np.median(absn)), "abs_over_albedo_p90": float(np.quantile(absn, 0.9)),

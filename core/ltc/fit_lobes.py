@@ -112,8 +112,25 @@ class ClothLobe(Lobe):
         return np.where(l[..., 2] > 0, 0.5 / np.pi, 0.0)
 
 
+class DisneySheenLobe(Lobe):
+    """Disney sheen (1 - l.h)^5 (Burley 2012, sec. 5.3; core.cloth.disney_sheen), colour 1, no 1/pi and no
+    roughness; cosine sampling (the lobe is broad, brightest towards grazing light)."""
+
+    def eval_cos(self, l, v, r):
+        _, l_dot_h = _half_vector_terms(l, v)
+        f = cloth.disney_sheen(l_dot_h)
+        return np.where((l[..., 2] > 0) & (v[..., 2] > 0), f * l[..., 2], 0.0)
+
+    def sample(self, v, r, u1, u2):
+        return _cosine_sample(u1, u2)
+
+    def pdf(self, l, v, r):
+        return np.maximum(l[..., 2], 0.0) / np.pi
+
+
 LOBES = {
     "ggx": GGXLobe("ggx", "single-scattering GGX, height-correlated Smith G2, F = 1"),
     "cod_diffuse": CodDiffuseLobe("cod_diffuse", "Call of Duty WWII multiscattering diffuse (Chan 2018), albedo 1"),
     "cloth": ClothLobe("cloth", "Ashikhmin velvet + Neubelt-Pettineo visibility (cloth), colour 1"),
+    "disney_sheen": DisneySheenLobe("disney_sheen", "Disney sheen (1 - l.h)^5, colour 1, no roughness"),
 }

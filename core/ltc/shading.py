@@ -19,7 +19,7 @@ import functools
 import operator
 from dataclasses import dataclass
 
-from .. import diffuse, multiscatter
+from .. import diffuse, multiscatter, sheen
 from .. import shading_ops as op
 from . import disk, polygon
 
@@ -133,6 +133,25 @@ def disney_sheen(tables, light, p, n, v, sheen_color):
     approximation is measured in docs/benchmarks/ltc.md."""
     value, _, fresnel = lobe_integral(tables, "ltc_cod_diffuse", light, p, n, v, SHEEN_TABLE_ROUGHNESS)
     return fresnel * value * sheen_color * 3.141592653589793
+
+
+# Zeltner et al. 2022 (core/sheen.py): the sheen lobe IS an LTC, Minv = [[a, 0, b], [0, a, 0], [0, 0, 1]]
+# (packed (1, 0, b/a, 1/a)), so its integral over the light is the LTC integral times the albedo R(mu_v, r);
+# Cycles' cut-off (|a| or R < 1e-5: no lobe) is kept.
+def zeltner_sheen(tables, light, p, n, v, roughness):
+    """(radiance per unit light radiance, albedo R(mu_v)) of the Zeltner sheen lobe over the light."""
+    mu = op.saturate(op.dot(n, v))
+    a, b, albedo = tables.zeltner_sheen(mu, sheen.zeltner_roughness(roughness))
+    keep = op.logical_and(sheen.zeltner_active(a, albedo), op.greater(op.dot(n, v), 0.0))
+    value = light.integral(tables, sheen.zeltner_packed_inverse(a, b), polygon.local_frame(n, v), p)
+    return op.select(keep, value * albedo, 0.0), op.select(keep, albedo, 0.0)
+
+
+# Disney sheen (1 - l.h)^5 (Burley 2012) with its own fitted LTC (table ltc_disney_sheen, core/ltc/fit_lobes.py):
+# the lobe has no roughness, so the table is read at r = 0.
+def disney_sheen_fitted(tables, light, p, n, v, sheen_color):
+    value, magnitude, _ = lobe_integral(tables, "ltc_disney_sheen", light, p, n, v, 0.0)
+    return magnitude * value * sheen_color
 
 
 def lambert(tables, light, p, n, v, albedo):

@@ -25,12 +25,15 @@ MEASURED = {
 # costly in every switch bounds the capacity from below.
 _SPECULAR_COST = {"none": 0, "single": 0, "turquin": 1, "fdez_aguera": 1, "kulla_conty": 2}
 _DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1}
+#: Only the talk's sheen is measured; the fitted Disney sheen has its structure (one LTC integral, another
+#: table), Zeltner's adds the layering of the lobes below, so no measured set bounds it.
+_SHEEN_COST = {"none": 0, "disney_talk": 1, "disney_fitted": 1, "zeltner": 2}
 
 
 def _at_least_as_costly(measured, features):
     return (_SPECULAR_COST[measured.specular] >= _SPECULAR_COST[features.specular]
             and _DIFFUSE_COST[measured.diffuse] >= _DIFFUSE_COST[features.diffuse]
-            and measured.sheen >= features.sheen and measured.cloth >= features.cloth)
+            and _SHEEN_COST[measured.sheen] >= _SHEEN_COST[features.sheen] and measured.cloth >= features.cloth)
 
 
 def light_capacity(features, world=False):

@@ -50,9 +50,31 @@ def combine_lobes(features, surface, lobe_values, light_color, area=False):
         w = surface["Cloth Weight"]
         spec = op.scale(spec, 1.0 - w) + op.scale(cloth, w)
     total = spec + op.scale(surface["Albedo"], lobe_values["Diffuse"])
-    if features.sheen:
-        total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
-    return op.vmul(light_color, total)
+    return op.vmul(light_color, add_sheen(features, surface, lobe_values, total))
+
+
+def add_sheen(features, surface, lobe_values, below):
+    """``below`` (the lobes under the sheen) plus the sheen lobe.  The Disney sheens add (Burley 2012, the
+    talk); Zeltner's is layered as the Principled BSDF does (Cycles' ``principled_bsdf_emission``): the
+    lobes below are weighted by 1 - max(sheen colour) x R(mu_v), R the sheen's directional albedo."""
+    if features.sheen == "none":
+        return below
+    return layer_sheen(features, surface, below, op.scale(surface["Sheen Color"], lobe_values["Sheen"]),
+                       lobe_values.get("Sheen Albedo"))
+
+
+def layer_sheen(features, surface, below, sheen, albedo):
+    """``below`` under the sheen radiance ``sheen`` (colour applied); ``albedo`` R(mu_v) (Zeltner's only)."""
+    if features.sheen == "zeltner":
+        below = op.scale(below, sheen_layer_weight(surface["Sheen Color"], albedo))
+    return below + sheen
+
+
+def sheen_layer_weight(sheen_color, albedo):
+    """Cycles' ``closure_layering_weight`` for the Principled sheen: saturate(1 - max_c(colour_c) R)."""
+    c = op.maximum(op.maximum(op.component(sheen_color, 0), op.component(sheen_color, 1)),
+                   op.component(sheen_color, 2))
+    return op.saturate(1.0 - c * albedo)
 
 
 def _without_specular(features, surface, lobe_values, light_color):
@@ -61,9 +83,7 @@ def _without_specular(features, surface, lobe_values, light_color):
     total = op.scale(surface["Albedo"], lobe_values["Diffuse"])
     if features.cloth:
         total = total + op.scale(op.scale(surface["Cloth Color"], lobe_values["Cloth"]), surface["Cloth Weight"])
-    if features.sheen:
-        total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
-    return op.vmul(light_color, total)
+    return op.vmul(light_color, add_sheen(features, surface, lobe_values, total))
 
 
 def lobe_keys(features):
@@ -73,13 +93,21 @@ def lobe_keys(features):
         keys.append("kulla_conty")
     if features.cloth:
         keys.append("cloth")
-    if features.sheen:
-        keys.append("sheen")
+    if features.sheen != "none":
+        keys.append(SHEEN_LOBES[features.sheen])
     return keys
+
+
+#: Sheen model -> its lobe (``lobes.LOBES``).
+SHEEN_LOBES = {"disney_talk": "sheen", "zeltner": "zeltner", "disney_fitted": "disney_fitted"}
 
 
 #: The surface terms a light's shading reads.
 SHADE_SURFACE = ("N", "V", "Roughness", "F0", "Albedo", "Wrap", "Sheen Color", "Cloth Weight", "Cloth Color")
+
+
+#: Surface terms only some lobes read (a shade function has them only when one of its lobes does).
+OPTIONAL_SURFACE = ("Sheen Roughness",)
 
 
 def light_color_name(kind):
@@ -103,7 +131,7 @@ def shade_function(kind, features):
             values.update(fn(tables, **_arguments(fn, kw)))
         return {"Radiance": combine_lobes(features, kw, values, kw[color_name], kind in lobes.AREA_KINDS)}
 
-    inputs = {k: SURFACE_OUTPUTS[k] for k in SHADE_SURFACE}
+    inputs = {k: SURFACE_OUTPUTS[k] for k in SHADE_SURFACE + OPTIONAL_SURFACE}
     if kind in lobes.AREA_KINDS + ("point", "spot"):
         inputs["Position"] = GEOMETRY_INPUTS["Position"]
     inputs.update(lobes.light_geometry_sockets(kind))

@@ -61,6 +61,7 @@ def _surface(**kw):
         "Albedo": op.scale(base, 1.0 - metallic),
         "Wrap": op.saturate(kw["Wrap"]),
         "Sheen Color": op.scale(_reflectance(kw["Sheen Tint"]), op.saturate(kw["Sheen Weight"])),
+        "Sheen Roughness": op.saturate(kw["Sheen Roughness"]),
         "Cloth Weight": op.saturate(kw["Cloth Weight"]),
         "Cloth Color": _reflectance(kw["Cloth Color"]),
         "Emission": _emission(kw["Emission Color"], kw["Emission Strength"]),

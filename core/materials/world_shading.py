@@ -50,7 +50,7 @@ import numpy as np
 
 from pathlib import Path
 
-from .. import indirect, multiscatter
+from .. import indirect, multiscatter, sheen
 from .. import shading_ops as op
 from ..conventions import alpha_from_roughness
 from ..fresnel import fresnel_average
@@ -60,6 +60,7 @@ from ..ir.tables import Table
 from ..ltc import polygon
 from ..ltc import shading as ltc_shading
 from ..lut.lookup import REFERENCES
+from .light_shading import layer_sheen
 from .rt_lit_interface import SURFACE_OUTPUTS, world_input
 
 PI = math.pi
@@ -268,6 +269,30 @@ SH_LTC_SHEEN = _ltc_lobe_function("Sheen", COD_TABLE, "Disney sheen as the talk:
                                   "magnitude pi x its Fresnel channel", SHEEN_TABLE_ROUGHNESS, use_fresnel=True)
 
 
+# Zeltner 2022 sheen under the world (core/sheen.py): the cosine lobe about the image of the cosine's peak
+# through the sheen's LTC (``indirect.ltc_lobe_axis(..., "peak")``: -c2 T1 + c0 N = N - (b/a) T1; the talk's axis
+# c1 T1 + c3 N is N itself for this LTC), scaled by the albedo R(mu_v).  Measured against the lobe's exact
+# integral under L2 SH environments (docs/sheen.md): median 11% (talk's axis 12%).
+def _zeltner_world_lobe(tables, **kw):
+    n, v = kw["N"], kw["V"]
+    a, b, albedo = tables.zeltner_sheen(op.saturate(op.dot(n, v)), sheen.zeltner_roughness(kw["Sheen Roughness"]))
+    keep = op.logical_and(sheen.zeltner_active(a, albedo), op.greater(op.dot(n, v), 0.0))
+    axis = indirect.ltc_lobe_axis(sheen.zeltner_packed_inverse(a, b), polygon.local_frame(n, v), "peak")
+    albedo = op.select(keep, albedo, 0.0)
+    return {"Axis": op.normalize(axis), "Magnitude": albedo, "Albedo": albedo}
+
+
+SH_LTC_ZELTNER = NodeFunction(
+    "RTL SH-LTC Zeltner Sheen", _zeltner_world_lobe,
+    {"N": _DIR, "V": _DIR, "Sheen Roughness": factor(0.5, "Sheen roughness")},
+    {"Axis": vector("Cosine lobe axis, unit", "NONE"),
+     "Magnitude": Socket("float", 0.0, description="Scale of the lobe: the sheen's albedo"),
+     "Albedo": Socket("float", 0.0, description="Directional albedo R(mu_v), for the layering below the sheen")},
+    "Zeltner sheen's LTC: lobe axis (the cosine peak's image) and albedo", tables=REFERENCES)
+SH_LTC_DISNEY_FITTED = _ltc_lobe_function("Disney Sheen Fitted", "ltc_disney_sheen",
+                                          "Disney sheen's own fitted LTC: lobe axis and magnitude", 0.0)
+
+
 # --- specular ---------------------------------------------------------------------------------------
 
 def _channel_specular(model, environment_ms):
@@ -328,6 +353,11 @@ WORLD_SURFACE = ("N", "V", "Roughness", "Dielectric F0", "Metal F0", "Metallic",
                  "Sheen Color", "Cloth Weight", "Cloth Color")
 
 
+def world_surface(features):
+    """The surface terms the world term of ``features`` reads (``WORLD_SURFACE``, + the sheen roughness)."""
+    return WORLD_SURFACE + (("Sheen Roughness",) if features.sheen == "zeltner" else ())
+
+
 def world_radiance(tables, features, env, surface, params):
     """Radiance towards the viewer from the environment (3-vector).
 
@@ -358,10 +388,14 @@ def world_radiance(tables, features, env, surface, params):
     total = op.vmul(surface["Albedo"], diffuse)
     if spec is not None:
         total = spec + total
-    if features.sheen:
-        lobe = SH_LTC_SHEEN(tables, N=n, V=v)
-        sheen = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
-        total = total + op.vmul(surface["Sheen Color"], sheen)
+    if features.sheen != "none":
+        if features.sheen == "zeltner":
+            lobe = SH_LTC_ZELTNER(tables, N=n, V=v, **{"Sheen Roughness": surface["Sheen Roughness"]})
+        else:
+            lobe = (SH_LTC_SHEEN if features.sheen == "disney_talk" else SH_LTC_DISNEY_FITTED)(tables, N=n, V=v)
+        sheen_lobe = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
+        total = layer_sheen(features, surface, total, op.vmul(surface["Sheen Color"], sheen_lobe),
+                            lobe["Albedo"] if features.sheen == "zeltner" else None)
     return op.scale(total, params["Strength"])
 
 
@@ -384,11 +418,11 @@ def shade_world_function(features, env):
     """``RTL Shade World (<features>)``: the environment's radiance towards the viewer."""
 
     def shade(tables, **kw):
-        surface = {k: kw[k] for k in WORLD_SURFACE}
+        surface = {k: kw[k] for k in world_surface(features)}
         params = {k: kw[world_input(k)] for k in WORLD_PARAMETERS}
         return {"Radiance": world_radiance(tables, features, env, surface, params)}
 
-    inputs = {k: SURFACE_OUTPUTS[k] for k in WORLD_SURFACE}
+    inputs = {k: SURFACE_OUTPUTS[k] for k in world_surface(features)}
     inputs.update({world_input(k): s for k, s in WORLD_PARAMETERS.items()})
     return NodeFunction(f"RTL Shade World ({features.label()}; {env.name})", shade, inputs,
                         {"Radiance": color((0.0, 0.0, 0.0), "Radiance towards the viewer from the world")},
@@ -399,6 +433,6 @@ def shade_world_function(features, env):
 def shade_world(tables, features, env, surface, params):
     """The world term: ``surface`` the "RTL Surface" outputs, ``params`` the ``WORLD_PARAMETERS``;
     arrays (``tables`` with data, the environment's table included) or Exprs."""
-    args = {k: surface[k] for k in WORLD_SURFACE}
+    args = {k: surface[k] for k in world_surface(features)}
     args.update({world_input(k): params[k] for k in WORLD_PARAMETERS})
     return shade_world_function(features, env)(tables, **args)["Radiance"]

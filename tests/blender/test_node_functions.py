@@ -14,7 +14,8 @@ pytest.importorskip("OpenEXR")
 pytestmark = pytest.mark.blender
 
 
-@pytest.mark.parametrize("lobe", ["ggx", "kulla_conty", "lambert", "cod", "wrapped", "cloth", "sheen"])
+@pytest.mark.parametrize("lobe", ["ggx", "kulla_conty", "lambert", "cod", "wrapped", "cloth", "sheen", "zeltner",
+                                  "disney_fitted"])
 def test_punctual_lobe_groups_match_numpy(empty_scene, tables, lobe):
     from rt_lookdev.core.materials import lobes
 
@@ -62,7 +63,8 @@ def test_interface_has_descriptions_ranges_and_panels(empty_scene, tables):
 
 
 @pytest.mark.parametrize("kind", ["quad", "disk"])
-@pytest.mark.parametrize("lobe", ["ggx", "kulla_conty", "lambert", "cod", "wrapped", "cloth", "sheen"])
+@pytest.mark.parametrize("lobe", ["ggx", "kulla_conty", "lambert", "cod", "wrapped", "cloth", "sheen", "zeltner",
+                                  "disney_fitted"])
 def test_area_lobe_groups_match_numpy(empty_scene, tables, kind, lobe):
     from rt_lookdev.addon.node_emit import MAX_GROUP_NODES, ensure_function_group, tree_node_counts
     from rt_lookdev.core.materials import lobes
@@ -83,7 +85,8 @@ def test_shade_groups_match_numpy(empty_scene, tables, kind):
 
     vals = shade_inputs(kind)
     for features in (Features("kulla_conty", "wrapped", sheen=True, cloth=True), Features("turquin", "cod"),
-                     Features("none", "cod", sheen=True, cloth=True)):
+                     Features("none", "cod", sheen=True, cloth=True), Features("turquin", "cod", sheen="zeltner"),
+                     Features("single", "lambert", sheen="disney_fitted")):
         fn = light_shading.shade_function(kind, features)
         check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, tables)
 
