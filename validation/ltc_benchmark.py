@@ -284,39 +284,45 @@ def disney_sheen_models(tables, n_quads, n_disks, seed=2020):
 
 
 def zeltner_exactness(lut_dir, n_quads, n_disks, seed=2022):
-    """The Zeltner sheen's area form (its own LTC's integral, core/ltc/shading.zeltner_sheen) vs brute force of
-    the same lobe (the LTC density times the albedo at the same table values): what the integrals' horizon
-    handling costs.  Random sheen roughness in [0.05, 1]."""
+    """The Zeltner sheen's area form vs brute force of the same lobe (the LTC density times the albedo at the
+    same table values): the LTC integral with the sphere table's horizon ("sphere table") and with the exact
+    horizon RT Lit shades it with ("exact horizon": quads clipped, disks by their closed form above the
+    horizon and an equal-area 12-gon clipped where they cross it).  Random sheen roughness in [0.05, 1]."""
     from ..core import sheen
 
     tables = lookup.LutSet.from_folder(lut_dir)
     sheen_table = tables.array("zeltner_sheen")
+    sphere = tables.array("ltc_ggx_mag")[..., 3]
     out = {}
     for kind, count in (("quad", n_quads), ("disk", n_disks)):
-        est, truth, albedo, theta = [], [], [], []
+        rows = {"sphere table": [], "exact horizon": [], "truth": [], "albedo": [], "theta": []}
         for r, th, v, geom in random_lights(kind, count, "cod_diffuse", seed):
             r = 0.05 + 0.95 * (r - 0.15) / 0.8
             mu = float(v[2])
             size = catalog.ZELTNER_SHEEN_SIZE
             a, b, alb = semantics.sample_bilinear(sheen_table, lookup.lut_coordinate(np.array(r), size),
                                                   lookup.lut_coordinate(np.array(mu), size))[:3]
-
             if alb < 1e-4:               # no lobe (Cycles' cut-off, or below it): nothing to integrate
                 continue
 
             def f_cos(l, vv, a=float(a), b=float(b), alb=float(alb)):
                 return alb * sheen.zeltner_density(l[..., 0], l[..., 1], l[..., 2], a, b)
 
-            truth.append(_truth(kind, f_cos, v, geom)[0])
-            albedo.append(float(alb))
-            theta.append(th)
+            rows["truth"].append(_truth(kind, f_cos, v, geom)[0])
+            rows["albedo"].append(float(alb))
+            rows["theta"].append(th)
             c = sheen.zeltner_packed_inverse(float(a), float(b))
             if kind == "quad":
-                value = polygon.ltc_polygon_integral_packed(c, list(geom), False, tables.array("ltc_ggx_mag")[..., 3])
+                clipless = polygon.ltc_polygon_integral_packed(c, list(geom), False, sphere)
+                exact = polygon.polygon_integral_horizon_clipped([matrix.transform_packed(c, q) for q in geom], 0.0,
+                                                                 list(geom))
             else:
-                value = disk.ltc_disk_integral_packed(c, *geom, False, tables.array("ltc_ggx_mag")[..., 3])
-            est.append(float(value) * float(alb))
-        out[kind] = _stats(est, truth, albedo, theta)
+                clipless = disk.ltc_disk_integral_packed(c, *geom, False, sphere)
+                exact = disk.disk_integral_horizon_clipped(*(matrix.transform_packed(c, q) for q in geom), 0.0, sphere)
+            rows["sphere table"].append(float(clipless) * float(alb))
+            rows["exact horizon"].append(float(exact) * float(alb))
+        out[kind] = {m: _stats(rows[m], rows["truth"], rows["albedo"], rows["theta"])
+                     for m in ("sphere table", "exact horizon")}
     return out
 
 
@@ -332,7 +338,8 @@ def sheen_markdown(res):
         for model in ("talk", "fitted"):
             lines.append(f"| disney_sheen/{kind} | {model} | {_fmt_stats(e[model])}")
     for kind, e in res["zeltner_exactness"].items():
-        lines.append(f"| zeltner/{kind} | own LTC | {_fmt_stats(e)}")
+        for model, stats in e.items():
+            lines.append(f"| zeltner/{kind} | own LTC, {model} | {_fmt_stats(stats)}")
     return lines + [""]
 
 

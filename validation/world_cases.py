@@ -66,6 +66,12 @@ TECHNIQUES = {
     "kulla_conty": (Features("kulla_conty", "lambert"), "MULTI_GGX",
                     "Kulla-Conty split sum + F_ms (1 - E) I, F0 = 1, vs Multiscatter GGX"),
 }
+#: Zeltner sheen (issue 17; the variant's roughness is the sheen roughness): its SH lobe vs Cycles' Sheen BSDF.
+TECHNIQUES["zeltner"] = (Features("none", "lambert", sheen="zeltner"), "SHEEN",
+                         "Zeltner sheen (SH cosine lobe about its LTC's peak, times its albedo) vs Cycles Sheen BSDF "
+                         "(Microfiber)")
+#: The sheen roughnesses of the zeltner row (full runs only).
+SHEEN_ROUGHNESS = (0.2, 0.5, 0.9)
 MULTISCATTER = ("turquin", "fdez_aguera", "fdez_aguera_radiance", "kulla_conty")
 
 
@@ -74,7 +80,7 @@ def technique_material(technique, roughness):
     specular: ``TECHNIQUES``), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
     from . import suite_cases as suite
 
-    base = technique if technique in ("lambert", "cod") else "ggx"
+    base = technique if technique in ("lambert", "cod", "zeltner") else "ggx"
     return suite.technique_material(base, roughness)
 
 
@@ -126,6 +132,8 @@ def node_variants(quick=False, kulla_conty=True):
         techs.append("kulla_conty")
     for t in techs:
         out += [WorldVariant(t, r) for r in rough]
+    if not quick:
+        out += [WorldVariant("zeltner", r) for r in SHEEN_ROUGHNESS]
     return out
 
 
@@ -256,7 +264,7 @@ def closure_material(closure, name):
     from . import suite_cases as suite
 
     kind, r = closure
-    technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin"}[kind]
+    technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin", "SHEEN": "zeltner"}[kind]
     return suite._closure_material(suite.Variant(technique, r), name)
 
 

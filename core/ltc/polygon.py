@@ -346,6 +346,131 @@ def ltc_polygon_vector_form_factor(minv, corners):
     return vector_form_factor([op.normalize(q) for q in _vectors(transform(minv, corners))])
 
 
+# --- horizon clipping, traceable (exact for lobes that live near the horizon) --------------------
+
+# Heitz et al. 2016 (ltc_code ``ltc_quad.fs``, its clipped branch ``ClipQuadToHorizon``), written without
+# branches as ``clip_to_horizon`` above (Sutherland & Hodgman 1974 against z = 0): every edge keeps its part
+# with z >= 0 as a (start, end) pair; an edge entirely below collapses onto the polygon's exit point (where
+# it leaves the upper half-space: a convex polygon has at most one), so the 2K points are the closed clipped
+# polygon with repeated points, whose zero-length edges add nothing.
+def _horizon_crossing(a, b):
+    """(point of the segment a-b on z = 0 (z set to exactly 0), a above, b above, a leaves: 0/1 floats)."""
+    za, zb = op.component(a, 2), op.component(b, 2)
+    above_a, above_b = 1.0 - op.less(za, 0.0), 1.0 - op.less(zb, 0.0)
+    crossing = above_a + above_b - 2.0 * above_a * above_b
+    t = op.safe_div(za, op.select(crossing, za - zb, 1.0))
+    x = a + op.scale(b - a, t)
+    return op.vec3(op.component(x, 0), op.component(x, 1), 0.0 * za), above_a, above_b, above_a * (1.0 - above_b)
+
+
+def _clip_edge(**kw):
+    x, above_a, above_b, leaves = _horizon_crossing(kw["A"], kw["B"])
+    return {"Crossing": x, "A Above": above_a, "B Above": above_b, "Leaves": leaves}
+
+
+_HORIZON_EDGE = NodeFunction(
+    "RTL Horizon Edge", _clip_edge,
+    {"A": vector("Edge start (transformed, local frame)", "XYZ"), "B": vector("Edge end", "XYZ")},
+    {"Crossing": vector("Where the edge meets z = 0 (when it does)", "XYZ"),
+     "A Above": Socket("float", 0.0, description="1 where A.z >= 0"),
+     "B Above": Socket("float", 0.0, description="1 where B.z >= 0"),
+     "Leaves": Socket("float", 0.0, description="1 where the edge goes from above to below the horizon")},
+    "One edge of a polygon against the horizon z = 0 (Sutherland-Hodgman)")
+
+
+def _clip_pair(**kw):
+    a, b, x, exit_point = kw["A"], kw["B"], kw["Crossing"], kw["Exit"]
+    return {"Start": op.vselect(kw["A Above"], a, op.vselect(kw["B Above"], x, exit_point)),
+            "End": op.vselect(kw["B Above"], b, op.vselect(kw["A Above"], x, exit_point))}
+
+
+_CLIP_PAIR = NodeFunction(
+    "RTL Horizon Clip Pair", _clip_pair,
+    {"A": vector("Edge start", "XYZ"), "B": vector("Edge end", "XYZ"),
+     "Crossing": vector("Where the edge meets z = 0", "XYZ"), "Exit": vector("The polygon's exit point", "XYZ"),
+     "A Above": Socket("float", 0.0, description="1 where A.z >= 0"),
+     "B Above": Socket("float", 0.0, description="1 where B.z >= 0")},
+    {"Start": vector("Start of the edge's part above z = 0 (the exit point when none)", "XYZ"),
+     "End": vector("End of the edge's part above z = 0 (the exit point when none)", "XYZ")},
+    "The part of one polygon edge above the horizon (Sutherland-Hodgman), as a start and an end point")
+
+
+def clip_to_horizon_traced(points):
+    """K vectors (transformed polygon, local frame) -> the 2K vectors of its part above z = 0 as a closed
+    sequence (``clip_to_horizon``'s, traceable; all zero when nothing is above)."""
+    pts = _vectors(points)
+    pairs = list(zip(pts, pts[1:] + pts[:1]))
+    edges = [_HORIZON_EDGE(A=a, B=b) for a, b in pairs]
+    exit_point = _sum([op.scale(e["Crossing"], e["Leaves"]) for e in edges])
+    out = []
+    for (a, b), e in zip(pairs, edges):
+        se = _CLIP_PAIR(A=a, B=b, Crossing=e["Crossing"], Exit=exit_point, **{"A Above": e["A Above"],
+                                                                             "B Above": e["B Above"]})
+        out += [se["Start"], se["End"]]
+    return out
+
+
+def _cross_z(a, b):
+    return op.component(a, 0) * op.component(b, 1) - op.component(a, 1) * op.component(b, 0)
+
+
+def _edge_term(**kw):
+    o = op.normalize(kw["O"])
+    a, b = op.normalize(kw["A"]), op.normalize(kw["B"])
+    w = edge_weight(a, b)
+    return {"Area": _cross_z(a - o, b - o) * w, "Flow": op.scale(b - a, w)}
+
+
+_EDGE_TERM = NodeFunction(
+    "RTL Form Factor Edge", _edge_term,
+    {"A": vector("Arc start (normalised inside)", "XYZ"), "B": vector("Arc end (normalised inside)", "XYZ"),
+     "O": vector("The polygon's first point (normalised inside)", "XYZ")},
+    {"Area": Socket("float", 0.0, description="z of w (A - O) x (B - O), w the fitted edge factor"),
+     "Flow": vector("w (B - A)", "XYZ")},
+    "One edge of Arvo's vector form factor in the cancellation-free sum of vector_form_factor (its z)")
+
+
+def form_factor_z_traced(points):
+    """z of the vector form factor (fitted edges) of the closed polygon ``points`` (not normalised): the sum of
+    ``vector_form_factor`` with one nested group per edge."""
+    pts = _vectors(points)
+    terms = [_EDGE_TERM(A=a, B=b, O=pts[0]) for a, b in zip(pts, pts[1:] + pts[:1])]
+    area = _sum([t["Area"] for t in terms[1:-1]])
+    return area + _cross_z(op.normalize(pts[0]), _sum([t["Flow"] for t in terms]))
+
+
+@functools.lru_cache(maxsize=None)
+def clipped_form_factor_function(k):
+    """"RTL Clipped Form Factor (<k> corners)": z of the vector form factor of a convex k-gon (transformed, local
+    frame, not normalised) clipped exactly at the horizon (``clip_to_horizon_traced``, ``form_factor_z_traced``)."""
+    def body(**kw):
+        return {"Fz": form_factor_z_traced(clip_to_horizon_traced([kw[f"p{i}"] for i in range(k)]))}
+
+    return NodeFunction(
+        f"RTL Clipped Form Factor ({k} corners)", body,
+        {f"p{i}": vector(f"Corner {i} (transformed, local frame)", "XYZ") for i in range(k)},
+        {"Fz": Socket("float", 0.0, description="z of the vector form factor of the polygon's part above z = 0 "
+                                                "(signed: negative seen from its back)")},
+        "Lambert's form factor of a convex polygon clipped exactly at the horizon (Heitz et al. 2016, eq. 11)")
+
+
+def clipped_side_value(fz, back, lit, two_sided):
+    """The clipped integral from its signed form factor: |fz| on the lit side (the back only when two-sided),
+    0 for a light seen edge-on (``lit`` 0)."""
+    value = op.saturate(op.select(back, -fz, fz))
+    return op.select(lit, op.select(back, value * two_sided, value), 0.0)
+
+
+def polygon_integral_horizon_clipped(transformed, two_sided, untransformed=None, center=None):
+    """``polygon_integral_clipless`` with the exact horizon: the transformed quad clipped to z >= 0
+    (``clip_to_horizon_traced``), then the z of its vector form factor (Heitz et al. 2016, eq. 11); the same
+    side and edge-on tests.  Any convex polygon (K corners, 2K clipped points)."""
+    pts = _vectors(transformed)
+    plane = pts if untransformed is None else _vectors(untransformed)
+    fz = clipped_form_factor_function(len(pts))(**{f"p{i}": q for i, q in enumerate(pts)})["Fz"]
+    return clipped_side_value(fz, behind(plane, center), off_plane(plane, center), two_sided)
+
+
 # --- the node function -------------------------------------------------------------------------
 
 def _quad_integral_node(tables, **inputs):
@@ -382,3 +507,21 @@ LTC_QUAD_INTEGRAL = NodeFunction(
     description="LTC integral over a quad light (Heitz et al. 2016, clipless form of Hill & Heitz 2017)",
     tables=lookup.REFERENCES)
 
+
+
+def _quad_integral_clipped_node(tables, **inputs):
+    c = tuple(inputs[f"c{i}"] for i in range(4))
+    corners = [inputs[f"p{i}"] for i in range(4)]
+    transformed = [matrix.transform_packed(c, q) for q in corners]
+    return {"Integral": polygon_integral_horizon_clipped(transformed, inputs["Two Sided"], corners, inputs["Center"])}
+
+
+#: ``LTC_QUAD_INTEGRAL`` with the exact horizon (``polygon_integral_horizon_clipped``): for lobes that live near the
+#: horizon (the Zeltner sheen at low roughness), where the sphere table's cap is far from the clipped polygon.
+LTC_QUAD_INTEGRAL_CLIPPED = NodeFunction(
+    "RTL LTC Quad Integral (Clipped)", _quad_integral_clipped_node, inputs=LTC_QUAD_INTEGRAL.input_sockets,
+    outputs={"Integral": Socket("float", 0.0, 0.0, 1.0, "FACTOR",
+                                "Integral of the normalised LTC over the light, clipped exactly at the horizon: "
+                                "multiply by the lobe's magnitude")},
+    description="LTC integral over a quad light with exact horizon clipping (Heitz et al. 2016)",
+    tables=lookup.REFERENCES)
