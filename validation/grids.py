@@ -281,6 +281,7 @@ def world_inputs(seed=5, size=SIZE):
             "Cloth Color": rng.random(shape + (3,)), "World Strength": rng.uniform(0.1, 3.0, shape),
             "World Rotation": rng.uniform(-3.5, 3.5, shape + (3,))}
     vals["Sheen Roughness"] = sheen_roughness(rng, shape)
+    vals.update(distribution_moments(rng, shape))
     vals["Scale"] = vals["Scale"] * (1.0 - vals["Bias"])
     coeffs = rng.normal(size=(9, 3))
     coeffs[0] += 4.0
@@ -288,6 +289,17 @@ def world_inputs(seed=5, size=SIZE):
         vals[f"SH {i}"] = np.broadcast_to(coeffs[i], shape + (3,)).copy()
         vals[f"World SH {i}"] = vals[f"SH {i}"]
     return {k: np.asarray(a, np.float32) for k, a in vals.items()}
+
+
+def distribution_moments(rng, shape, k=6):
+    """First and second moments ("Mean", "XX", "YY", "ZZ", "XY", "YZ", "XZ") of random distributions of unit
+    directions (each the average of ``k`` random unit vectors): what ``world_shading.SH_MOMENTS`` takes."""
+    d = unit_vectors(rng, shape + (k,))
+    out = {"Mean": d.mean(axis=-2)}
+    for name, (i, j) in (("XX", (0, 0)), ("YY", (1, 1)), ("ZZ", (2, 2)), ("XY", (0, 1)), ("YZ", (1, 2)),
+                         ("XZ", (0, 2))):
+        out[name] = (d[..., i] * d[..., j]).mean(axis=-1)
+    return out
 
 
 def ltc_integral_inputs(ltc_table, size=SIZE, seed=13):

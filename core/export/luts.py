@@ -93,7 +93,7 @@ class ExportTable:
 def _axes(spec):
     w, h = spec.width, spec.height
     u = {"parameter": "r (Blender roughness; GGX alpha = max(r^2, 1e-4))", "nodes": w, "node": "r = i / (W - 1)"}
-    if spec.name == "zeltner_sheen":
+    if spec.name.startswith("zeltner_sheen"):
         u["parameter"] = "r (sheen roughness, clamped to [1e-3, 1] before the lookup)"
     if spec.height == 1:
         v = {"parameter": "none (one row)", "nodes": 1, "node": "sample at v = 0.5"}
@@ -113,7 +113,7 @@ def _origin(path):
 
 def _catalog_table(luts, name, export_name=None):
     spec = catalog.TABLES[name]
-    kind = "ltc" if name.startswith("ltc_") else "sheen" if name == "zeltner_sheen" else "energy"
+    kind = "ltc" if name.startswith("ltc_") else "sheen" if name.startswith("zeltner_sheen") else "energy"
     return ExportTable(export_name or name, name, luts.array(name).astype(np.float32), spec.channels,
                        spec.description, _axes(spec), CITATIONS[kind] + (CITATIONS["sphere"] if name.endswith("_mag") else []),
                        _origin(luts[name].source))
@@ -146,7 +146,7 @@ def layout_tables(luts, layout="rtl"):
         else:
             name = "ltc" if prefix == "ltc_ggx" else prefix
             out += [_catalog_table(luts, prefix + "_inv", f"{name}_1"), _catalog_table(luts, prefix + "_mag", f"{name}_2")]
-    out.append(_catalog_table(luts, "zeltner_sheen"))
+    out += [_catalog_table(luts, n) for n in ("zeltner_sheen", "zeltner_sheen_sh1", "zeltner_sheen_sh2")]
     out.append(_sphere_table(luts))
     return out
 

@@ -115,7 +115,8 @@ MEASURED_GROUPS["zeltner_sheen"] = BakeGroup(
     name="zeltner_sheen", generator_version=1,
     params={"size": ZELTNER_SHEEN_SIZE, "source": "Cycles Sheen BSDF (Microfiber), Blender 5.2.3",
             "method": "sun (angle 0) renders, 1 sample, direct light; linear least squares per cell",
-            "paper": "Zeltner, Burley, Chiang 2022, Practical Multiple-Scattering Sheen Using LTCs"},
+            "paper": "Zeltner, Burley, Chiang 2022, Practical Multiple-Scattering Sheen Using LTCs",
+            "derived": "zeltner_sheen_sh1/sh2: moments of each cell's LTC, 128 x 256 product rule (sh_moments)"},
     sources=(), measured=True, command="python scripts/measure_sheen_table.py")
 
 LTC_INV_CHANNELS = ("R = c0 = Minv_xx, G = c1 = Minv_zx, B = c2 = Minv_xz, A = c3 = Minv_zz "
@@ -155,6 +156,14 @@ TABLES["zeltner_sheen"] = TableSpec(
                 "density; sheen roughness clamped to [1e-3, 1]",
     axis_u="u: sheen roughness r (Cycles clamps it to >= 1e-3); node i at r = i/(W-1), texel centre (i+0.5)/W",
     axis_v=AXIS_V_MU)
+for _name, _channels in (("zeltner_sheen_sh1", "R = E[x], G = E[z], B = E[x z]; A = 1"),
+                          ("zeltner_sheen_sh2", "R = E[x^2], G = E[y^2], B = E[z^2]; A = 1")):
+    TABLES[_name] = TableSpec(
+        name=_name, filename=_name + ".exr", group="zeltner_sheen", width=ZELTNER_SHEEN_SIZE,
+        height=ZELTNER_SHEEN_SIZE, channels=_channels,
+        description="moments of the Zeltner sheen's normalised LTC per (mu, r) in the local frame (N = +Z, V towards "
+                    "+X), derived from zeltner_sheen: the world term's exact L2 SH integral",
+        axis_u=TABLES["zeltner_sheen"].axis_u, axis_v=AXIS_V_MU)
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
     TABLES[_prefix + "_inv"] = TableSpec(
         name=_prefix + "_inv", filename=_prefix + "_inv.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,

@@ -50,7 +50,7 @@ def test_world_helper_groups_match_numpy(empty_scene, tables):
     from rt_lookdev.core.materials import world_shading as world
 
     for fn in (world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD, world.SH_LTC_CLOTH, world.SH_LTC_SHEEN,
-               world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED):
+               world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED, world.SH_MOMENTS):
         _check(fn, tables)
     for model in ("single", "turquin", "fdez_aguera", "kulla_conty"):
         for form in (("irradiance", "radiance") if model == "fdez_aguera" else ("irradiance",)):

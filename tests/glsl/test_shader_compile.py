@@ -36,7 +36,8 @@ def test_every_library_function_compiles(glslang_path, dialect):
 
     functions = list(library.all_functions()) + [world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD,
                                                  world.SH_LTC_CLOTH, world.SH_LTC_SHEEN,
-                                                 world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED]
+                                                 world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED,
+                                                 world.SH_MOMENTS]
     for fn in functions:
         module = _compile_function(fn, dialect)
         # readable output: one function per node function, named after it, with its description
