@@ -272,9 +272,9 @@ SH_LTC_SHEEN = _ltc_lobe_function("Sheen", COD_TABLE, "Disney sheen as the talk:
 # Zeltner 2022 sheen under the world (core/sheen.py): its exact integral against the L2 SH radiance.  L2 radiance
 # is a polynomial of degree 2 in the direction, so int L D = sum_i c_i E_D[Y_i] needs only D's first and second
 # moments (tables zeltner_sheen_sh1/2, computed per cell from the measured LTC: validation/sheen_table.py), taken
-# from the local frame (T1, T2, N) to the world's here.  Measured against the lobe's integral under two studio
-# HDRIs (docs/sheen.md): median 20% (studio, r = 0.5) and 9% (sunset, r = 0.2) where the talk's cosine lobe
-# about the LTC's peak gave 44% and 31%; what remains is the L2 truncation of the environment.
+# from the local frame (T1, T2, N) to the world's here.  Against Cycles under two studio HDRIs (docs/sheen.md):
+# median 21% (studio, r = 0.5) and 7.9% (sunset, r = 0.2) where the talk's cosine lobe about the LTC's peak gave
+# 49% and 28%; what remains is the L2 truncation of the environment.
 def _zeltner_world_lobe(tables, **kw):
     n, v = kw["N"], kw["V"]
     mu, r = op.saturate(op.dot(n, v)), sheen.zeltner_roughness(kw["Sheen Roughness"])

@@ -109,3 +109,50 @@ def test_principled_layering(tables):
     want = surface["Albedo"] * values["Diffuse"] * weight + surface["Sheen Color"] * values["Sheen"]
     np.testing.assert_allclose(got, want, rtol=1e-12)
     assert 0.0 < values["Sheen Albedo"] < 1.0
+
+
+def _random_lights(rng, count):
+    centre = rng.normal(size=(count, 3)) * 1.2 + np.array([0.0, 0.0, 0.3])
+    u = rng.normal(size=(count, 3)) * rng.uniform(0.05, 1.0, (count, 1))
+    w = rng.normal(size=(count, 3))
+    w -= u * (np.sum(u * w, -1) / np.sum(u * u, -1))[:, None]
+    w *= rng.uniform(0.05, 1.0, (count, 1)) / np.linalg.norm(w, axis=-1, keepdims=True)
+    c = np.stack([rng.uniform(0.2, 1.5, count), rng.uniform(-0.1, 0.1, count), rng.uniform(-0.5, 0.5, count),
+                  rng.uniform(0.3, 20.0, count)], axis=-1)              # c0 c3 > c1 c2: a positive determinant
+    return centre, u, w, c
+
+
+def test_clipped_integrals_trace_and_clip_exactly(tables):
+    """The exact-horizon integrals: the quad's equals the numpy clipped reference (Sutherland-Hodgman + exact
+    edges, ``polygon.ltc_polygon_integral(method="clipped")``); the disk's is its closed form where the
+    transformed disk lies above the horizon; both trace to the same values (IR, float32)."""
+    from rt_lookdev.core.ir import trace
+    from rt_lookdev.core.ir.numpy_backend import evaluate
+    from rt_lookdev.core.ltc import disk, matrix
+
+    rng = np.random.default_rng(17)
+    centre, u, w, c = _random_lights(rng, 400)
+    corners = np.stack([centre - u - w, centre + u - w, centre + u + w, centre - u + w], axis=1)
+    for two in (0.0, 1.0):
+        args = {f"c{i}": c[:, i] for i in range(4)}
+        args.update({f"p{i}": corners[:, i] for i in range(4)}, Center=centre, **{"Two Sided": np.full(len(c), two)})
+        got = polygon.LTC_QUAD_INTEGRAL_CLIPPED(tables, **args)["Integral"]
+        want = polygon.ltc_polygon_integral(matrix.unpack_inverse(c), corners, bool(two), method="clipped")
+        lit = polygon.off_plane(list(np.moveaxis(corners, 1, 0)), centre)
+        np.testing.assert_allclose(got, np.where(lit, want, 0.0), rtol=2e-5, atol=2e-6)
+        names = {k: ("vector" if np.ndim(v) == 2 else "float") for k, v in args.items()}
+        _, out = trace(lambda **kw: polygon.LTC_QUAD_INTEGRAL_CLIPPED(tables, **kw)["Integral"], names)
+        np.testing.assert_allclose(evaluate(out, args, np.float32, tables), got, rtol=1e-4, atol=1e-6)
+
+        dargs = {f"c{i}": c[:, i] for i in range(4)}
+        dargs.update({"Center": centre, "Axis U": u, "Axis V": w, "Two Sided": np.full(len(c), two)})
+        got = disk.LTC_DISK_INTEGRAL_CLIPPED(tables, **dargs)["Integral"]
+        closed = disk.LTC_DISK_INTEGRAL(tables, **dargs)["Integral"]
+        t = [matrix.transform_packed(tuple(c.T), x) for x in (centre, u, w)]
+        above = t[0][:, 2] > np.hypot(t[1][:, 2], t[2][:, 2])
+        assert 50 < above.sum() < 350
+        np.testing.assert_array_equal(got[above], closed[above])
+        names = {k: ("vector" if np.ndim(v) == 2 else "float") for k, v in dargs.items()}
+        _, out = trace(lambda **kw: disk.LTC_DISK_INTEGRAL_CLIPPED(tables, **kw)["Integral"], names)
+        np.testing.assert_allclose(evaluate(out, dargs, np.float32, tables), got, rtol=1e-4, atol=1e-6)
+        assert got.min() >= 0.0 and got.max() <= 1.0
