@@ -196,7 +196,8 @@ def test_round_trip_is_lossless(bpy_module, convert, factory):
 
     result = convert.principled_to_rt_lit(mat, factory)
     assert set(result.ignored_inputs) == {"Alpha", "Subsurface Weight", "Transmission Weight", "Coat Weight"}
-    assert convert.stored_features(mat) == Features()
+    converted = Features(sheen="zeltner")         # the material has Sheen Weight 0.4: Blender's own sheen
+    assert convert.stored_features(mat) == converted
 
     back = convert.rt_lit_to_principled(mat)
     assert back.status == "converted" and not back.warnings
@@ -208,8 +209,8 @@ def test_round_trip_is_lossless(bpy_module, convert, factory):
     assert "RT Lit" not in tree.nodes and not any(n.bl_idname == "NodeFrame" for n in tree.nodes)
     assert all(k not in p for k in ("rtl_role", "rtl_location", "rtl_parent", "rtl_hide"))
     # The RT Lit group datablock is left alone; the material still remembers its switches.
-    assert set(bpy_module.data.node_groups.keys()) >= groups | {factory(Features()).name}
-    assert convert.stored_features(mat) == Features()
+    assert set(bpy_module.data.node_groups.keys()) >= groups | {factory(converted).name}
+    assert convert.stored_features(mat) == converted
 
 
 def test_edits_made_in_rt_lit_survive(bpy_module, convert, factory):
