@@ -378,73 +378,91 @@ _HORIZON_EDGE = NodeFunction(
     "One edge of a polygon against the horizon z = 0 (Sutherland-Hodgman)")
 
 
-def _clip_pair(**kw):
-    a, b, x, exit_point = kw["A"], kw["B"], kw["Crossing"], kw["Exit"]
-    return {"Start": op.vselect(kw["A Above"], a, op.vselect(kw["B Above"], x, exit_point)),
-            "End": op.vselect(kw["B Above"], b, op.vselect(kw["A Above"], x, exit_point))}
-
-
-_CLIP_PAIR = NodeFunction(
-    "RTL Horizon Clip Pair", _clip_pair,
-    {"A": vector("Edge start", "XYZ"), "B": vector("Edge end", "XYZ"),
-     "Crossing": vector("Where the edge meets z = 0", "XYZ"), "Exit": vector("The polygon's exit point", "XYZ"),
-     "A Above": Socket("float", 0.0, description="1 where A.z >= 0"),
-     "B Above": Socket("float", 0.0, description="1 where B.z >= 0")},
-    {"Start": vector("Start of the edge's part above z = 0 (the exit point when none)", "XYZ"),
-     "End": vector("End of the edge's part above z = 0 (the exit point when none)", "XYZ")},
-    "The part of one polygon edge above the horizon (Sutherland-Hodgman), as a start and an end point")
-
-
-def clip_to_horizon_traced(points):
-    """K vectors (transformed polygon, local frame) -> the 2K vectors of its part above z = 0 as a closed
-    sequence (``clip_to_horizon``'s, traceable; all zero when nothing is above)."""
-    pts = _vectors(points)
-    pairs = list(zip(pts, pts[1:] + pts[:1]))
-    edges = [_HORIZON_EDGE(A=a, B=b) for a, b in pairs]
-    exit_point = _sum([op.scale(e["Crossing"], e["Leaves"]) for e in edges])
-    out = []
-    for (a, b), e in zip(pairs, edges):
-        se = _CLIP_PAIR(A=a, B=b, Crossing=e["Crossing"], Exit=exit_point, **{"A Above": e["A Above"],
-                                                                             "B Above": e["B Above"]})
-        out += [se["Start"], se["End"]]
-    return out
-
-
 def _cross_z(a, b):
     return op.component(a, 0) * op.component(b, 1) - op.component(a, 1) * op.component(b, 0)
 
 
-def _edge_term(**kw):
-    o = op.normalize(kw["O"])
-    a, b = op.normalize(kw["A"]), op.normalize(kw["B"])
+def _arc_terms(a, b, o):
+    """(z of w (a - o) x (b - o), w (b - a)) of the arc a -> b (unit vectors), w its fitted edge factor: one
+    edge of ``vector_form_factor``'s cancellation-free sum about the unit point o."""
     w = edge_weight(a, b)
-    return {"Area": _cross_z(a - o, b - o) * w, "Flow": op.scale(b - a, w)}
+    return _cross_z(a - o, b - o) * w, op.scale(b - a, w)
 
 
-_EDGE_TERM = NodeFunction(
-    "RTL Form Factor Edge", _edge_term,
-    {"A": vector("Arc start (normalised inside)", "XYZ"), "B": vector("Arc end (normalised inside)", "XYZ"),
-     "O": vector("The polygon's first point (normalised inside)", "XYZ")},
-    {"Area": Socket("float", 0.0, description="z of w (A - O) x (B - O), w the fitted edge factor"),
-     "Flow": vector("w (B - A)", "XYZ")},
-    "One edge of Arvo's vector form factor in the cancellation-free sum of vector_form_factor (its z)")
+def _clip_point(above, point, other_above, crossing, exit_point):
+    """An edge end after clipping: the point itself when above; else the edge's crossing when the edge's other
+    end is above; else (the whole edge below) the polygon's exit point."""
+    return op.vselect(above, point, op.vselect(other_above, crossing, exit_point))
 
 
-def form_factor_z_traced(points):
-    """z of the vector form factor (fitted edges) of the closed polygon ``points`` (not normalised): the sum of
-    ``vector_form_factor`` with one nested group per edge."""
+# One edge (A -> B) of the clipped polygon and the connection to the next edge's start (B -> C's clipped part),
+# summed as two arcs of the form factor: the clipped polygon streams edge by edge (2K arcs, repeated points adding
+# nothing), so only the K corners stay live (Cycles' SVM stack: a 12-gon's 24 clipped points held at once
+# overflowed it in Blender 4.5).
+def clipped_edge_terms(a, b, c, exit_point, origin):
+    """{"Area", "Flow"} of the edge a -> b clipped at the horizon plus the arc to the clipped start of b -> c
+    (``clipped_form_factor_z``); ``origin`` a point of the clipped polygon (not normalised)."""
+    o = op.normalize(origin)
+    x_ab, above_a, above_b, _ = _horizon_crossing(a, b)
+    x_bc, _, above_c, _ = _horizon_crossing(b, c)
+    start = op.normalize(_clip_point(above_a, a, above_b, x_ab, exit_point))
+    end = op.normalize(_clip_point(above_b, b, above_a, x_ab, exit_point))
+    following = op.normalize(_clip_point(above_b, b, above_c, x_bc, exit_point))
+    area1, flow1 = _arc_terms(start, end, o)
+    area2, flow2 = _arc_terms(end, following, o)
+    return {"Area": area1 + area2, "Flow": flow1 + flow2}
+
+
+def exit_part(a, b):
+    """The edge a -> b's share of the polygon's exit point: its crossing where it leaves the upper half-space
+    (a convex polygon has at most one such edge), else 0."""
+    x, _, _, leaves = _horizon_crossing(a, b)
+    return op.scale(x, leaves)
+
+
+def clipped_origin(a, b, exit_point):
+    """The clipped start of the edge a -> b: a point of the clipped polygon (the form factor sum's origin)."""
+    x, above_a, above_b, _ = _horizon_crossing(a, b)
+    return _clip_point(above_a, a, above_b, x, exit_point)
+
+
+def _clipped_edge(**kw):
+    return clipped_edge_terms(kw["A"], kw["B"], kw["C"], kw["Exit"], kw["O"])
+
+
+_CLIPPED_EDGE = NodeFunction(
+    "RTL Clipped Edge", _clipped_edge,
+    {"A": vector("Edge start (transformed, local frame)", "XYZ"), "B": vector("Edge end", "XYZ"),
+     "C": vector("The next edge's end", "XYZ"), "Exit": vector("Where the polygon leaves the upper half-space",
+                                                              "XYZ"),
+     "O": vector("A point of the clipped polygon (normalised inside): the sum's origin", "XYZ")},
+    {"Area": Socket("float", 0.0, description="z of sum w (a - o) x (b - o) over the edge's two arcs"),
+     "Flow": vector("sum w (b - a) over the edge's two arcs", "XYZ")},
+    "One edge of a polygon clipped at the horizon (Sutherland-Hodgman) in Arvo's form factor, with the arc to "
+    "the next edge's clipped start")
+
+
+def clipped_form_factor_z(points):
+    """z of the vector form factor (fitted edges) of the convex polygon ``points`` (K vectors, transformed,
+    local frame, not normalised) clipped at z = 0: ``clip_to_horizon``'s closed sequence (every edge's part
+    above the horizon, an edge entirely below collapsed onto the exit point), summed as ``vector_form_factor``
+    does, one nested group per edge; traceable.  Negative seen from the polygon's back."""
     pts = _vectors(points)
-    terms = [_EDGE_TERM(A=a, B=b, O=pts[0]) for a, b in zip(pts, pts[1:] + pts[:1])]
-    area = _sum([t["Area"] for t in terms[1:-1]])
-    return area + _cross_z(op.normalize(pts[0]), _sum([t["Flow"] for t in terms]))
+    k = len(pts)
+    edges = [_HORIZON_EDGE(A=pts[i], B=pts[(i + 1) % k]) for i in range(k)]
+    exit_point = _sum([op.scale(e["Crossing"], e["Leaves"]) for e in edges])
+    e0 = edges[0]
+    origin = _clip_point(e0["A Above"], pts[0], e0["B Above"], e0["Crossing"], exit_point)
+    terms = [_CLIPPED_EDGE(A=pts[i], B=pts[(i + 1) % k], C=pts[(i + 2) % k], Exit=exit_point, O=origin)
+             for i in range(k)]
+    return _sum([t["Area"] for t in terms]) + _cross_z(op.normalize(origin), _sum([t["Flow"] for t in terms]))
 
 
 @functools.lru_cache(maxsize=None)
 def clipped_form_factor_function(k):
-    """"RTL Clipped Form Factor (<k> corners)": z of the vector form factor of a convex k-gon (transformed, local
-    frame, not normalised) clipped exactly at the horizon (``clip_to_horizon_traced``, ``form_factor_z_traced``)."""
+    """"RTL Clipped Form Factor (<k> corners)": ``clipped_form_factor_z`` of a convex k-gon."""
     def body(**kw):
-        return {"Fz": form_factor_z_traced(clip_to_horizon_traced([kw[f"p{i}"] for i in range(k)]))}
+        return {"Fz": clipped_form_factor_z([kw[f"p{i}"] for i in range(k)])}
 
     return NodeFunction(
         f"RTL Clipped Form Factor ({k} corners)", body,
@@ -463,7 +481,7 @@ def clipped_side_value(fz, back, lit, two_sided):
 
 def polygon_integral_horizon_clipped(transformed, two_sided, untransformed=None, center=None):
     """``polygon_integral_clipless`` with the exact horizon: the transformed quad clipped to z >= 0
-    (``clip_to_horizon_traced``), then the z of its vector form factor (Heitz et al. 2016, eq. 11); the same
+    (``clipped_form_factor_z``), then the z of its vector form factor (Heitz et al. 2016, eq. 11); the same
     side and edge-on tests.  Any convex polygon (K corners, 2K clipped points)."""
     pts = _vectors(transformed)
     plane = pts if untransformed is None else _vectors(untransformed)
