@@ -156,3 +156,27 @@ def test_clipped_integrals_trace_and_clip_exactly(tables):
         _, out = trace(lambda **kw: disk.LTC_DISK_INTEGRAL_CLIPPED(tables, **kw)["Integral"], names)
         np.testing.assert_allclose(evaluate(out, dargs, np.float32, tables), got, rtol=1e-4, atol=1e-6)
         assert got.min() >= 0.0 and got.max() <= 1.0
+
+
+def test_measured_tables_are_kept_not_baked(tmp_path):
+    """zeltner_sheen cannot be baked by numpy: the bake never computes it (``lut_bake`` knows only GROUPS),
+    ``keep_measured`` copies the shipped files into another LUT folder, and a missing or corrupt copy says how to
+    get it back."""
+    from rt_lookdev.core import lut_bake
+    from rt_lookdev.core.lut import catalog
+
+    assert "zeltner_sheen" not in catalog.GROUPS and catalog.bake_group("zeltner_sheen").measured
+    specs = [s for s in catalog.TABLES.values() if s.group == "zeltner_sheen"]
+    assert {s.name for s in specs} == {"zeltner_sheen", "zeltner_sheen_sh1", "zeltner_sheen_sh2"}
+    missing = catalog.table_status(specs[0], tmp_path)
+    assert missing.state == "missing" and "measure_sheen_table.py" in missing.message
+    assert catalog.keep_measured(tmp_path, log=lambda line: None) == {"zeltner_sheen": "copied"}
+    assert lut_bake.group_is_current("zeltner_sheen", tmp_path)
+    assert catalog.keep_measured(tmp_path, log=lambda line: None) == {"zeltner_sheen": "kept"}
+    path = tmp_path / specs[0].filename
+    data = bytearray(path.read_bytes())
+    data[-200] ^= 0xFF                                     # a damaged copy
+    path.write_bytes(bytes(data))
+    corrupt = catalog.table_status(specs[0], tmp_path)
+    assert corrupt.state == "corrupt" and "measured, not baked" in corrupt.message
+    assert catalog.keep_measured(tmp_path, log=lambda line: None) == {"zeltner_sheen": "copied"}
