@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, RT_LIT_INPUTS, SPECULAR_MODELS,
+from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, RT_LIT_INPUTS, SHEEN_MODELS, SPECULAR_MODELS,
                                                Features)
 from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, connect_engine_outputs, not_a_light, restore_emission_sampling,
                      restore_engine_outputs)
@@ -39,7 +39,7 @@ from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, connect_engine_outputs, not
 #: Principled BSDF input -> RT Lit input (same names).  "Normal" is link-only.
 MAPPED_INPUTS = (
     "Base Color", "Metallic", "Roughness", "IOR", "Specular IOR Level", "Specular Tint",
-    "Sheen Weight", "Sheen Tint", "Emission Color", "Emission Strength", "Normal",
+    "Sheen Weight", "Sheen Roughness", "Sheen Tint", "Emission Color", "Emission Strength", "Normal",
 )
 #: Principled's Diffuse Roughness (Blender 4.3+) drives RT Lit's "oren_nayar" diffuse (core/rough_diffuse.py).
 MAPPED_INPUTS += ("Diffuse Roughness",)
@@ -84,6 +84,16 @@ SPECULAR_ITEMS = tuple((m, *SPECULAR_LABELS.get(m, (m.replace("_", " ").title(),
 ENVIRONMENT_MS_ITEMS = (('irradiance', "Irradiance", "Fdez-Aguera 2019: FssEss x radiance + FmsEms x irradiance"),
                         ('radiance', "Radiance", "The talk: (FssEss + FmsEms) x prefiltered radiance"))
 DIFFUSE_ITEMS = tuple((m, *DIFFUSE_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in DIFFUSE_MODELS)
+SHEEN_LABELS = {
+    "none": ("None", "No sheen lobe"),
+    "zeltner": ("Zeltner (Principled)", "Zeltner, Burley & Chiang 2022: the sheen of Blender's Principled BSDF, "
+                "layered over the lobes below as Principled does; uses Sheen Roughness"),
+    "disney_fitted": ("Disney (fitted LTC)", "Disney sheen (1 - l.h)^5 with its own fitted LTC under area lights"),
+    "disney_talk": ("Disney (talk)", "Disney sheen as the talk shades it: the CoD table at r = 0.5 under area lights"),
+}
+SHEEN_ITEMS = tuple((m, *SHEEN_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SHEEN_MODELS)
+#: The sheen model a conversion picks for a Principled material with sheen.
+PRINCIPLED_SHEEN = "zeltner"
 
 
 class ConversionError(ValueError):
@@ -313,9 +323,8 @@ def draw_switches(layout, owner):
     sub.active = owner.specular == 'fdez_aguera'
     sub.prop(owner, "environment_ms")
     layout.prop(owner, "diffuse")
-    row = layout.row()
-    row.prop(owner, "sheen")
-    row.prop(owner, "cloth")
+    layout.prop(owner, "sheen")
+    layout.prop(owner, "cloth")
 
 
 def principled_uses_sheen(material):
@@ -352,7 +361,7 @@ def stored_features(material):
         data = data.to_dict() if hasattr(data, "to_dict") else dict(data)
         features = Features.from_dict(data)
         return Features(specular=str(features.specular), diffuse=str(features.diffuse),
-                        sheen=bool(features.sheen), cloth=bool(features.cloth),
+                        sheen=str(features.sheen), cloth=bool(features.cloth),
                         environment_ms=str(features.environment_ms))
     except (TypeError, ValueError):
         return None
@@ -441,13 +450,15 @@ def principled_to_rt_lit(material, group_factory, features=None):
     """Convert ``material`` from a Principled BSDF to an RT Lit material (see the module doc).
 
     ``group_factory(features) -> ShaderNodeTree`` gives the RT Lit group; ``features`` (a
-    ``Features``) defaults to the ones stored on the material, else ``Features()``.  Returns a
+    ``Features``) defaults to the ones stored on the material, else ``Features()`` (with the Zeltner sheen,
+    Principled's, when the Principled BSDF has sheen).  Returns a
     ``ConversionResult``; raises ``ConversionError`` (changing nothing) when the active Material
     Output's Surface is not fed by a Principled BSDF (or an RT Lit material).
     """
     tree, output = _check_editable(material)
     if features is None:
-        features = stored_features(material) or Features()
+        features = stored_features(material) or (Features(sheen=PRINCIPLED_SHEEN) if principled_uses_sheen(material)
+                                                 else Features())
     elif not isinstance(features, Features):
         features = Features.from_dict(features)
 
@@ -532,7 +543,7 @@ def principled_to_rt_lit(material, group_factory, features=None):
     _store_features(material, features)
     result = ConversionResult(material.name, "converted", ignored_inputs=ignored, features=features)
     sheen = principled.inputs["Sheen Weight"]
-    if not features.sheen and (sheen.is_linked or sheen.default_value > 0.0):
+    if features.sheen == "none" and (sheen.is_linked or sheen.default_value > 0.0):
         amount = "a linked Sheen Weight" if sheen.is_linked else f"Sheen Weight {sheen.default_value:.3g}"
         result.warnings.append(f"Material '{material.name}': {amount} is not shaded because the sheen switch is "
                                "off; convert again with Sheen on to keep it")
@@ -697,7 +708,7 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
         items=DIFFUSE_ITEMS,
         default=Features().diffuse,
     )
-    sheen: BoolProperty(name="Sheen", description="Build the group with the Disney sheen lobe",
+    sheen: EnumProperty(name="Sheen", description="Sheen lobe the RT Lit group is built with", items=SHEEN_ITEMS,
                         default=Features().sheen)
     cloth: BoolProperty(name="Cloth", description="Build the group with the Ashikhmin cloth lobe",
                         default=Features().cloth)
@@ -728,7 +739,8 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
             self.sheen, self.cloth = stored.sheen, stored.cloth
             self.environment_ms = stored.environment_ms
         else:
-            self.sheen = self.sheen or principled_uses_sheen(material)
+            if self.sheen == "none" and principled_uses_sheen(material):
+                self.sheen = PRINCIPLED_SHEEN
             if principled_uses_diffuse_roughness(material):
                 self.diffuse = "oren_nayar"
         return context.window_manager.invoke_props_dialog(self)

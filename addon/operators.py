@@ -289,6 +289,8 @@ class RTL_OT_bake_luts(ModalTask, bpy.types.Operator):
         from ..core.lut import catalog
 
         lut_dir = preferences.lut_directory(context)
+        if lut_dir.is_dir():      # measured tables are not baked: kept, or copied from the shipped folder
+            catalog.keep_measured(lut_dir, log=lambda line: print(f"RT Lookdev: {line}"))
         todo = [g for g in catalog.GROUPS if self.force or not lut_bake.group_is_current(g, lut_dir)]
         if not todo:
             self.report({'INFO'}, f"All {len(catalog.TABLES)} LUT tables in {lut_dir} are current; nothing to bake")
@@ -300,8 +302,10 @@ class RTL_OT_bake_luts(ModalTask, bpy.types.Operator):
                 index = todo.index(group) if group in todo else 0
                 progress((index + done / max(total, 1)) / len(todo), f"{group} {done}/{total}")
             lut_dir.mkdir(parents=True, exist_ok=True)
-            return lut_bake.bake(lut_dir, force=force, progress=step, groups=todo, workers=1,
-                                 log=lambda line: print(f"RT Lookdev: {line}"))
+            records = lut_bake.bake(lut_dir, force=force, progress=step, groups=todo, workers=1,
+                                    log=lambda line: print(f"RT Lookdev: {line}"))
+            catalog.keep_measured(lut_dir, log=lambda line: print(f"RT Lookdev: {line}"))
+            return records
 
         def finish(records):
             preferences.refresh_status(lut_dir)

@@ -16,7 +16,7 @@ from ..core.materials.rt_lit_interface import Features
 from . import convert
 
 _ENUMS = {"specular": convert.SPECULAR_ITEMS, "diffuse": convert.DIFFUSE_ITEMS,
-          "environment_ms": convert.ENVIRONMENT_MS_ITEMS}
+          "environment_ms": convert.ENVIRONMENT_MS_ITEMS, "sheen": convert.SHEEN_ITEMS}
 
 
 def _features(material):
@@ -57,7 +57,7 @@ def _enum(name, label):
 class RTL_PG_switches(bpy.types.PropertyGroup):
     specular: _enum("specular", "Specular")
     diffuse: _enum("diffuse", "Diffuse")
-    sheen: BoolProperty(name="Sheen", get=_getter("sheen"), set=_setter("sheen"))
+    sheen: _enum("sheen", "Sheen")
     cloth: BoolProperty(name="Cloth", get=_getter("cloth"), set=_setter("cloth"))
     environment_ms: _enum("environment_ms", "World Multiscattering")
 

@@ -35,6 +35,7 @@ def main(argv=None):
     if not args.status:
         try:
             bake.bake(args.lut_dir, force=args.force, progress=_progress)
+            catalog.keep_measured(args.lut_dir)      # measured tables: kept or copied, never baked
         except exr_io.LutError as ex:          # e.g. a read-only folder: the message says what to do
             print(f"bake_luts.py: error: {ex}", file=sys.stderr)
             return 2

@@ -111,7 +111,15 @@ def punctual_lobe_inputs(seed=3, size=SIZE):
     r.reshape(-1)[:8] = [0.0, 1.0, 0.0, 1.0, 0.5, 0.0, 1e-3, 1.0]
     wrap = rng.random(shape).astype(np.float32)
     wrap.reshape(-1)[:3] = [0.0, 1.0, 1.0]
-    return {"N": n, "V": v, "L": l, "Roughness": r, "Wrap": wrap, "Diffuse Roughness": _diffuse_roughness(rng, shape)}
+    return {"N": n, "V": v, "L": l, "Roughness": r, "Wrap": wrap, "Diffuse Roughness": _diffuse_roughness(rng, shape),
+            "Sheen Roughness": sheen_roughness(rng, shape)}
+
+
+def sheen_roughness(rng, shape):
+    """Sheen roughness per texel: Cycles' floor 1e-3 and the ends of the range first, then random."""
+    r = rng.random(shape).astype(np.float32)
+    r.reshape(-1)[:6] = [0.0, 1e-3, 1.0, 0.5, 2e-3, 1.0 / 31.0]
+    return r
 
 
 def area_lobe_inputs(kind, seed=5, size=SIZE):
@@ -134,7 +142,8 @@ def area_lobe_inputs(kind, seed=5, size=SIZE):
     u[9], w[9] = [1e-4, 0, 0], [0, 1e-4, 0]      # tiny
     r = rng.random(count)
     r[:6] = [0.0, 1.0, 0.0, 1.0, 0.5, 1e-3]
-    vals = {"Position": p, "N": n, "V": v, "Roughness": r, "Wrap": rng.random(count)}
+    vals = {"Position": p, "N": n, "V": v, "Roughness": r, "Wrap": rng.random(count),
+            "Sheen Roughness": sheen_roughness(rng, (count,))}
     vals["Diffuse Roughness"] = _diffuse_roughness(rng, count)
     if kind == "quad":
         corners = [center - u - w, center + u - w, center + u + w, center - u + w]
@@ -287,6 +296,8 @@ def world_inputs(seed=5, size=SIZE):
             "Sheen Color": rng.random(shape + (3,)), "Cloth Weight": rng.random(shape),
             "Cloth Color": rng.random(shape + (3,)), "World Strength": rng.uniform(0.1, 3.0, shape),
             "World Rotation": rng.uniform(-3.5, 3.5, shape + (3,))}
+    vals["Sheen Roughness"] = sheen_roughness(rng, shape)
+    vals.update(distribution_moments(rng, shape))
     vals["Scale"] = vals["Scale"] * (1.0 - vals["Bias"])
     coeffs = rng.normal(size=(9, 3))
     coeffs[0] += 4.0
@@ -295,6 +306,17 @@ def world_inputs(seed=5, size=SIZE):
         vals[f"World SH {i}"] = vals[f"SH {i}"]
     vals["Diffuse Roughness"] = _diffuse_roughness(rng, shape)
     return {k: np.asarray(a, np.float32) for k, a in vals.items()}
+
+
+def distribution_moments(rng, shape, k=6):
+    """First and second moments ("Mean", "XX", "YY", "ZZ", "XY", "YZ", "XZ") of random distributions of unit
+    directions (each the average of ``k`` random unit vectors): what ``world_shading.SH_MOMENTS`` takes."""
+    d = unit_vectors(rng, shape + (k,))
+    out = {"Mean": d.mean(axis=-2)}
+    for name, (i, j) in (("XX", (0, 0)), ("YY", (1, 1)), ("ZZ", (2, 2)), ("XY", (0, 1)), ("YZ", (1, 2)),
+                         ("XZ", (0, 2))):
+        out[name] = (d[..., i] * d[..., j]).mean(axis=-1)
+    return out
 
 
 def ltc_integral_inputs(ltc_table, size=SIZE, seed=13):

@@ -268,7 +268,7 @@ def bound(family, values):
     sum of their bounds, 2 + the sheen weight."""
     if family.bound != LAYERED:
         return np.float64(1.0)
-    sheen = np.clip(values["Sheen Weight"].astype(np.float64), 0.0, 1.0) if family.features.sheen else 0.0
+    sheen = np.clip(values["Sheen Weight"].astype(np.float64), 0.0, 1.0) if family.features.sheen != "none" else 0.0
     return 2.0 + sheen
 
 

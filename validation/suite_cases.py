@@ -94,6 +94,19 @@ TECHNIQUES["cod_cycles"] = (Features("none", "cod"), "cycles",
                             "CoD WWII diffuse with Roughness = sigma vs Cycles Diffuse BSDF with Roughness sigma")
 #: Base colour of the rough-diffuse variants (the multiple scattering's colour is non-linear in it).
 ROUGH_DIFFUSE_COLOR = (0.8, 0.55, 0.3)
+#: Sheen (issue 17): Zeltner's against Cycles' own closures (the variant's roughness is the sheen roughness);
+#: both Disney sheens against their integral.
+TECHNIQUES.update({
+    "zeltner": (Features("none", "lambert", sheen="zeltner"), "cycles",
+                "Zeltner sheen vs Cycles Sheen BSDF (Microfiber)"),
+    "zeltner_principled": (Features("none", "lambert", sheen="zeltner"), "cycles",
+                           "Lambert under Zeltner sheen (Principled's layering) vs Cycles Principled BSDF with "
+                           "Specular IOR Level 0"),
+    "disney_fitted": (Features("none", "lambert", sheen="disney_fitted"), "brute",
+                      "Disney sheen with its fitted LTC vs its integral"),
+})
+#: The Principled material of "zeltner_principled": base colour and sheen weight.
+ZELTNER_PRINCIPLED = {"Base Color": (0.5, 0.3, 0.2), "Sheen Weight": 0.8}
 
 
 def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
@@ -117,10 +130,15 @@ def technique_material(technique, roughness=0.5, color=None, wrap=0.5):
         m.update({"Base Color": color or (0.5, 0.25, 0.1), "IOR": 1.5, "Specular IOR Level": 0.5})
     elif technique == "cloth":
         m.update({"Metallic": 1.0, "Cloth Weight": 1.0, "Cloth Color": color or WHITE})
-    elif technique == "sheen":
+    elif technique in ("sheen", "disney_fitted"):
         m.update({"Metallic": 1.0, "Sheen Weight": 1.0, "Sheen Tint": color or WHITE})
     elif technique in ("oren_nayar", "cod_cycles"):
         m.update({"Base Color": color or ROUGH_DIFFUSE_COLOR, "Diffuse Roughness": float(roughness)})
+    elif technique == "zeltner":
+        m.update({"Metallic": 1.0, "Sheen Weight": 1.0, "Sheen Tint": color or WHITE, "Sheen Roughness": float(roughness)})
+    elif technique == "zeltner_principled":
+        m.update({"Base Color": color or ZELTNER_PRINCIPLED["Base Color"], "Sheen Weight": ZELTNER_PRINCIPLED["Sheen Weight"],
+                  "Sheen Tint": WHITE, "Sheen Roughness": float(roughness)})
     else:
         raise ValueError(f"unknown technique {technique!r}")
     return m
@@ -323,6 +341,7 @@ def build_cases(seed=0, quick=False):
                           description=f"{spec.describe()}: Turquin, Fdez-Aguera, Kulla-Conty (rows) at Metallic 0.5, "
                                       "r = 0.3, 0.6, 0.9", tags={"light": spec.kind}))
     cases += rough_diffuse_cases(cases)
+    cases += sheen_cases(cases)
     return cases
 
 
@@ -339,6 +358,22 @@ def rough_diffuse_cases(cases):
                             description=f"{case.lights[0].describe()}: Oren-Nayar (top) and CoD (bottom), "
                                         "sigma = 0.3, 0.6, 1, vs Cycles' rough Diffuse BSDF",
                             tags=dict(case.tags, rough_diffuse=True)))
+
+
+#: The sheen row (issue 17): Zeltner at three sheen roughnesses and under Principled's layering (Cycles truth),
+#: the fitted and the talk's Disney sheen (brute force).
+SHEEN_ROW = [Variant("zeltner", 0.2), Variant("zeltner", 0.5), Variant("zeltner", 0.9),
+             Variant("zeltner_principled", 0.5), Variant("disney_fitted"), Variant("sheen")]
+
+
+def sheen_cases(cases):
+    """The sheen row under the lights of the quad0, quad1, disk4, disk5, point, spot and sun cases."""
+    out = []
+    for case in cases:
+        stem = case.name.replace("_closures", "")
+        if stem in ("quad0", "quad1", "disk4", "disk5", "point", "spot", "sun"):
+            out.append(Case(f"{stem}_sheen", case.lights, SHEEN_ROW, columns=3,
+                            description=f"{case.lights[0].describe()}: sheen models", tags=dict(case.tags)))
     return out
 
 
@@ -553,6 +588,20 @@ def _closure_material(variant, name):
         shader = glossy("MULTI_GGX")
     elif t == "metal":
         shader = metallic(m["Base Color"])
+    elif t == "zeltner":
+        shader = nt.nodes.new("ShaderNodeBsdfSheen")
+        shader.distribution = "MICROFIBER"
+        shader.inputs["Color"].default_value = tuple(np.multiply(m["Sheen Tint"], m["Sheen Weight"])) + (1.0,)
+        shader.inputs["Roughness"].default_value = m["Sheen Roughness"]
+    elif t == "zeltner_principled":
+        shader = nt.nodes.new("ShaderNodeBsdfPrincipled")
+        values = {"Base Color": tuple(m["Base Color"]) + (1.0,), "Metallic": 0.0, "Specular IOR Level": 0.0,
+                  "Sheen Weight": m["Sheen Weight"], "Sheen Roughness": m["Sheen Roughness"],
+                  "Sheen Tint": tuple(m["Sheen Tint"]) + (1.0,), "Coat Weight": 0.0, "Transmission Weight": 0.0,
+                  "Subsurface Weight": 0.0, "Diffuse Roughness": 0.0}
+        for name, value in values.items():
+            if name in shader.inputs:              # Diffuse Roughness: Blender 4.3+
+                shader.inputs[name].default_value = value
     elif t == "dielectric" or t.startswith("mix_"):
         from ..core.materials.surface import dielectric_f0
 

@@ -69,6 +69,12 @@ TECHNIQUES = {
     "kulla_conty": (Features("kulla_conty", "lambert"), "MULTI_GGX",
                     "Kulla-Conty split sum + F_ms (1 - E) I, F0 = 1, vs Multiscatter GGX"),
 }
+#: Zeltner sheen (issue 17; the variant's roughness is the sheen roughness): its SH lobe vs Cycles' Sheen BSDF.
+TECHNIQUES["zeltner"] = (Features("none", "lambert", sheen="zeltner"), "SHEEN",
+                         "Zeltner sheen (SH cosine lobe about its LTC's peak, times its albedo) vs Cycles Sheen BSDF "
+                         "(Microfiber)")
+#: The sheen roughnesses of the zeltner row (full runs only).
+SHEEN_ROUGHNESS = (0.2, 0.5, 0.9)
 MULTISCATTER = ("turquin", "fdez_aguera", "fdez_aguera_radiance", "kulla_conty")
 #: The rough diffuse and CoD against Cycles' Diffuse BSDF with Roughness sigma (closure "ROUGH_DIFFUSE", sigma):
 #: the same references as under the lights (suite_cases "oren_nayar" / "cod_cycles"), white.
@@ -92,7 +98,7 @@ def technique_material(technique, roughness):
 
     if technique in ("oren_nayar", "cod_cycles"):
         return suite.technique_material(technique, roughness, suite.WHITE)
-    base = technique if technique in ("lambert", "cod", "cod_wrapped") else "ggx"
+    base = technique if technique in ("lambert", "cod", "cod_wrapped", "zeltner") else "ggx"
     return suite.technique_material(base, roughness)
 
 
@@ -147,6 +153,8 @@ def node_variants(quick=False, kulla_conty=True, rough_diffuse=False):
         techs += ["kulla_conty", "cod_wrapped"]
     for t in techs:
         out += [WorldVariant(t, r) for r in rough]
+    if not quick:
+        out += [WorldVariant("zeltner", r) for r in SHEEN_ROUGHNESS]
     return out + (rough_diffuse_variants() if rough_diffuse else [])
 
 
@@ -277,7 +285,7 @@ def closure_material(closure, name):
     from . import suite_cases as suite
 
     kind, r = closure
-    technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin", "ROUGH_DIFFUSE": "oren_nayar"}[kind]
+    technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin", "ROUGH_DIFFUSE": "oren_nayar", "SHEEN": "zeltner"}[kind]
     color = suite.WHITE if kind == "ROUGH_DIFFUSE" else None        # white, as the node block's variants
     return suite._closure_material(suite.Variant(technique, r, color), name)
 

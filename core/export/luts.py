@@ -66,6 +66,8 @@ CITATIONS = {
 #: The rough-diffuse LTC pair's lobe (core/rough_diffuse.py).
 CITATIONS["oren_nayar"] = ["Fujii, A tiny improvement of Oren-Nayar reflectance model (improved Oren-Nayar)",
                            "Portsmouth, Kutz & Hill 2025, EON: A Practical Energy-Preserving Rough Diffuse BRDF (JCGT 14(1))"]
+CITATIONS["sheen"] = ["Zeltner, Burley & Chiang 2022, Practical Multiple-Scattering Sheen Using Linearly Transformed "
+                      "Cosines (the fit, measured from Blender's Cycles)"] + CITATIONS["ltc"]
 
 
 class LutExportError(RuntimeError):
@@ -97,6 +99,8 @@ def _axes(spec):
     if spec.axis_u == catalog.AXIS_U_DIFFUSE_ROUGHNESS:
         u = {"parameter": "sigma (diffuse roughness: Principled's Diffuse Roughness)", "nodes": w,
              "node": "sigma = i / (W - 1)"}
+    if spec.name.startswith("zeltner_sheen"):
+        u["parameter"] = "r (sheen roughness, clamped to [1e-3, 1] before the lookup)"
     if spec.height == 1:
         v = {"parameter": "none (one row)", "nodes": 1, "node": "sample at v = 0.5"}
     elif spec.axis_v == catalog.AXIS_V_SQRT_ONE_MINUS_MU:
@@ -115,7 +119,7 @@ def _origin(path):
 
 def _catalog_table(luts, name, export_name=None):
     spec = catalog.TABLES[name]
-    kind = "ltc" if name.startswith("ltc_") else "energy"
+    kind = "ltc" if name.startswith("ltc_") else "sheen" if name.startswith("zeltner_sheen") else "energy"
     return ExportTable(export_name or name, name, luts.array(name).astype(np.float32), spec.channels,
                        spec.description, _axes(spec), CITATIONS[kind] + (CITATIONS["sphere"] if name.endswith("_mag") else [])
                        + (CITATIONS["oren_nayar"] if name.startswith("ltc_oren_nayar") else []),
@@ -149,6 +153,7 @@ def layout_tables(luts, layout="rtl"):
         else:
             name = "ltc" if prefix == "ltc_ggx" else prefix
             out += [_catalog_table(luts, prefix + "_inv", f"{name}_1"), _catalog_table(luts, prefix + "_mag", f"{name}_2")]
+    out += [_catalog_table(luts, n) for n in ("zeltner_sheen", "zeltner_sheen_sh1", "zeltner_sheen_sh2")]
     out.append(_sphere_table(luts))
     return out
 

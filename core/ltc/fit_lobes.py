@@ -120,9 +120,26 @@ class OrenNayarLobe(CodDiffuseLobe):
         return rough_diffuse.fon_single_scatter_cos(l[..., 2], v[..., 2], np.sum(l * v, axis=-1), r)
 
 
+class DisneySheenLobe(Lobe):
+    """Disney sheen (1 - l.h)^5 (Burley 2012, sec. 5.3; core.cloth.disney_sheen), colour 1, no 1/pi and no
+    roughness; cosine sampling (the lobe is broad, brightest towards grazing light)."""
+
+    def eval_cos(self, l, v, r):
+        _, l_dot_h = _half_vector_terms(l, v)
+        f = cloth.disney_sheen(l_dot_h)
+        return np.where((l[..., 2] > 0) & (v[..., 2] > 0), f * l[..., 2], 0.0)
+
+    def sample(self, v, r, u1, u2):
+        return _cosine_sample(u1, u2)
+
+    def pdf(self, l, v, r):
+        return np.maximum(l[..., 2], 0.0) / np.pi
+
+
 LOBES = {
     "ggx": GGXLobe("ggx", "single-scattering GGX, height-correlated Smith G2, F = 1"),
     "cod_diffuse": CodDiffuseLobe("cod_diffuse", "Call of Duty WWII multiscattering diffuse (Chan 2018), albedo 1"),
     "cloth": ClothLobe("cloth", "Ashikhmin velvet + Neubelt-Pettineo visibility (cloth), colour 1"),
     "oren_nayar": OrenNayarLobe("oren_nayar", "Fujii's improved Oren-Nayar single scattering, albedo 1"),
+    "disney_sheen": DisneySheenLobe("disney_sheen", "Disney sheen (1 - l.h)^5, colour 1, no roughness"),
 }

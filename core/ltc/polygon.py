@@ -346,6 +346,149 @@ def ltc_polygon_vector_form_factor(minv, corners):
     return vector_form_factor([op.normalize(q) for q in _vectors(transform(minv, corners))])
 
 
+# --- horizon clipping, traceable (exact for lobes that live near the horizon) --------------------
+
+# Heitz et al. 2016 (ltc_code ``ltc_quad.fs``, its clipped branch ``ClipQuadToHorizon``), written without
+# branches as ``clip_to_horizon`` above (Sutherland & Hodgman 1974 against z = 0): every edge keeps its part
+# with z >= 0 as a (start, end) pair; an edge entirely below collapses onto the polygon's exit point (where
+# it leaves the upper half-space: a convex polygon has at most one), so the 2K points are the closed clipped
+# polygon with repeated points, whose zero-length edges add nothing.
+def _horizon_crossing(a, b):
+    """(point of the segment a-b on z = 0 (z set to exactly 0), a above, b above, a leaves: 0/1 floats)."""
+    za, zb = op.component(a, 2), op.component(b, 2)
+    above_a, above_b = 1.0 - op.less(za, 0.0), 1.0 - op.less(zb, 0.0)
+    crossing = above_a + above_b - 2.0 * above_a * above_b
+    t = op.safe_div(za, op.select(crossing, za - zb, 1.0))
+    x = a + op.scale(b - a, t)
+    return op.vec3(op.component(x, 0), op.component(x, 1), 0.0 * za), above_a, above_b, above_a * (1.0 - above_b)
+
+
+def _clip_edge(**kw):
+    x, above_a, above_b, leaves = _horizon_crossing(kw["A"], kw["B"])
+    return {"Crossing": x, "A Above": above_a, "B Above": above_b, "Leaves": leaves}
+
+
+_HORIZON_EDGE = NodeFunction(
+    "RTL Horizon Edge", _clip_edge,
+    {"A": vector("Edge start (transformed, local frame)", "XYZ"), "B": vector("Edge end", "XYZ")},
+    {"Crossing": vector("Where the edge meets z = 0 (when it does)", "XYZ"),
+     "A Above": Socket("float", 0.0, description="1 where A.z >= 0"),
+     "B Above": Socket("float", 0.0, description="1 where B.z >= 0"),
+     "Leaves": Socket("float", 0.0, description="1 where the edge goes from above to below the horizon")},
+    "One edge of a polygon against the horizon z = 0 (Sutherland-Hodgman)")
+
+
+def _cross_z(a, b):
+    return op.component(a, 0) * op.component(b, 1) - op.component(a, 1) * op.component(b, 0)
+
+
+def _arc_terms(a, b, o):
+    """(z of w (a - o) x (b - o), w (b - a)) of the arc a -> b (unit vectors), w its fitted edge factor: one
+    edge of ``vector_form_factor``'s cancellation-free sum about the unit point o."""
+    w = edge_weight(a, b)
+    return _cross_z(a - o, b - o) * w, op.scale(b - a, w)
+
+
+def _clip_point(above, point, other_above, crossing, exit_point):
+    """An edge end after clipping: the point itself when above; else the edge's crossing when the edge's other
+    end is above; else (the whole edge below) the polygon's exit point."""
+    return op.vselect(above, point, op.vselect(other_above, crossing, exit_point))
+
+
+# One edge (A -> B) of the clipped polygon and the connection to the next edge's start (B -> C's clipped part),
+# summed as two arcs of the form factor: the clipped polygon streams edge by edge (2K arcs, repeated points adding
+# nothing), so only the K corners stay live (Cycles' SVM stack: a 12-gon's 24 clipped points held at once
+# overflowed it in Blender 4.5).
+def clipped_edge_terms(a, b, c, exit_point, origin):
+    """{"Area", "Flow"} of the edge a -> b clipped at the horizon plus the arc to the clipped start of b -> c
+    (``clipped_form_factor_z``); ``origin`` a point of the clipped polygon (not normalised)."""
+    o = op.normalize(origin)
+    x_ab, above_a, above_b, _ = _horizon_crossing(a, b)
+    x_bc, _, above_c, _ = _horizon_crossing(b, c)
+    start = op.normalize(_clip_point(above_a, a, above_b, x_ab, exit_point))
+    end = op.normalize(_clip_point(above_b, b, above_a, x_ab, exit_point))
+    following = op.normalize(_clip_point(above_b, b, above_c, x_bc, exit_point))
+    area1, flow1 = _arc_terms(start, end, o)
+    area2, flow2 = _arc_terms(end, following, o)
+    return {"Area": area1 + area2, "Flow": flow1 + flow2}
+
+
+def exit_part(a, b):
+    """The edge a -> b's share of the polygon's exit point: its crossing where it leaves the upper half-space
+    (a convex polygon has at most one such edge), else 0."""
+    x, _, _, leaves = _horizon_crossing(a, b)
+    return op.scale(x, leaves)
+
+
+def clipped_origin(a, b, exit_point):
+    """The clipped start of the edge a -> b: a point of the clipped polygon (the form factor sum's origin)."""
+    x, above_a, above_b, _ = _horizon_crossing(a, b)
+    return _clip_point(above_a, a, above_b, x, exit_point)
+
+
+def _clipped_edge(**kw):
+    return clipped_edge_terms(kw["A"], kw["B"], kw["C"], kw["Exit"], kw["O"])
+
+
+_CLIPPED_EDGE = NodeFunction(
+    "RTL Clipped Edge", _clipped_edge,
+    {"A": vector("Edge start (transformed, local frame)", "XYZ"), "B": vector("Edge end", "XYZ"),
+     "C": vector("The next edge's end", "XYZ"), "Exit": vector("Where the polygon leaves the upper half-space",
+                                                              "XYZ"),
+     "O": vector("A point of the clipped polygon (normalised inside): the sum's origin", "XYZ")},
+    {"Area": Socket("float", 0.0, description="z of sum w (a - o) x (b - o) over the edge's two arcs"),
+     "Flow": vector("sum w (b - a) over the edge's two arcs", "XYZ")},
+    "One edge of a polygon clipped at the horizon (Sutherland-Hodgman) in Arvo's form factor, with the arc to "
+    "the next edge's clipped start")
+
+
+def clipped_form_factor_z(points):
+    """z of the vector form factor (fitted edges) of the convex polygon ``points`` (K vectors, transformed,
+    local frame, not normalised) clipped at z = 0: ``clip_to_horizon``'s closed sequence (every edge's part
+    above the horizon, an edge entirely below collapsed onto the exit point), summed as ``vector_form_factor``
+    does, one nested group per edge; traceable.  Negative seen from the polygon's back."""
+    pts = _vectors(points)
+    k = len(pts)
+    edges = [_HORIZON_EDGE(A=pts[i], B=pts[(i + 1) % k]) for i in range(k)]
+    exit_point = _sum([op.scale(e["Crossing"], e["Leaves"]) for e in edges])
+    e0 = edges[0]
+    origin = _clip_point(e0["A Above"], pts[0], e0["B Above"], e0["Crossing"], exit_point)
+    terms = [_CLIPPED_EDGE(A=pts[i], B=pts[(i + 1) % k], C=pts[(i + 2) % k], Exit=exit_point, O=origin)
+             for i in range(k)]
+    return _sum([t["Area"] for t in terms]) + _cross_z(op.normalize(origin), _sum([t["Flow"] for t in terms]))
+
+
+@functools.lru_cache(maxsize=None)
+def clipped_form_factor_function(k):
+    """"RTL Clipped Form Factor (<k> corners)": ``clipped_form_factor_z`` of a convex k-gon."""
+    def body(**kw):
+        return {"Fz": clipped_form_factor_z([kw[f"p{i}"] for i in range(k)])}
+
+    return NodeFunction(
+        f"RTL Clipped Form Factor ({k} corners)", body,
+        {f"p{i}": vector(f"Corner {i} (transformed, local frame)", "XYZ") for i in range(k)},
+        {"Fz": Socket("float", 0.0, description="z of the vector form factor of the polygon's part above z = 0 "
+                                                "(signed: negative seen from its back)")},
+        "Lambert's form factor of a convex polygon clipped exactly at the horizon (Heitz et al. 2016, eq. 11)")
+
+
+def clipped_side_value(fz, back, lit, two_sided):
+    """The clipped integral from its signed form factor: |fz| on the lit side (the back only when two-sided),
+    0 for a light seen edge-on (``lit`` 0)."""
+    value = op.saturate(op.select(back, -fz, fz))
+    return op.select(lit, op.select(back, value * two_sided, value), 0.0)
+
+
+def polygon_integral_horizon_clipped(transformed, two_sided, untransformed=None, center=None):
+    """``polygon_integral_clipless`` with the exact horizon: the transformed quad clipped to z >= 0
+    (``clipped_form_factor_z``), then the z of its vector form factor (Heitz et al. 2016, eq. 11); the same
+    side and edge-on tests.  Any convex polygon (K corners, 2K clipped points)."""
+    pts = _vectors(transformed)
+    plane = pts if untransformed is None else _vectors(untransformed)
+    fz = clipped_form_factor_function(len(pts))(**{f"p{i}": q for i, q in enumerate(pts)})["Fz"]
+    return clipped_side_value(fz, behind(plane, center), off_plane(plane, center), two_sided)
+
+
 # --- the node function -------------------------------------------------------------------------
 
 def _quad_integral_node(tables, **inputs):
@@ -382,3 +525,21 @@ LTC_QUAD_INTEGRAL = NodeFunction(
     description="LTC integral over a quad light (Heitz et al. 2016, clipless form of Hill & Heitz 2017)",
     tables=lookup.REFERENCES)
 
+
+
+def _quad_integral_clipped_node(tables, **inputs):
+    c = tuple(inputs[f"c{i}"] for i in range(4))
+    corners = [inputs[f"p{i}"] for i in range(4)]
+    transformed = [matrix.transform_packed(c, q) for q in corners]
+    return {"Integral": polygon_integral_horizon_clipped(transformed, inputs["Two Sided"], corners, inputs["Center"])}
+
+
+#: ``LTC_QUAD_INTEGRAL`` with the exact horizon (``polygon_integral_horizon_clipped``): for lobes that live near the
+#: horizon (the Zeltner sheen at low roughness), where the sphere table's cap is far from the clipped polygon.
+LTC_QUAD_INTEGRAL_CLIPPED = NodeFunction(
+    "RTL LTC Quad Integral (Clipped)", _quad_integral_clipped_node, inputs=LTC_QUAD_INTEGRAL.input_sockets,
+    outputs={"Integral": Socket("float", 0.0, 0.0, 1.0, "FACTOR",
+                                "Integral of the normalised LTC over the light, clipped exactly at the horizon: "
+                                "multiply by the lobe's magnitude")},
+    description="LTC integral over a quad light with exact horizon clipping (Heitz et al. 2016)",
+    tables=lookup.REFERENCES)

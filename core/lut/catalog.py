@@ -56,6 +56,10 @@ class BakeGroup:
     generator_version: int
     params: dict = field(hash=False)
     sources: tuple  # module files (relative to the package root) whose code defines the values
+    #: Measured from another renderer (not computed by numpy): kept as shipped, never re-baked; ``command``
+    #: (re)measures it.
+    measured: bool = False
+    command: str = ""
 
 
 ENERGY_SIZE = 64
@@ -88,6 +92,7 @@ _LTC_SOURCES = ("core/ltc/fit.py", "core/ltc/fit_lobes.py", "core/ltc/matrix.py"
 #: The module of each LTC lobe's BRDF beyond GGX (only its own group depends on it).
 _LTC_BRDF_SOURCES = {"ltc_cod_diffuse": ("core/diffuse.py",), "ltc_cloth": ("core/cloth.py",),
                      "ltc_oren_nayar": ("core/rough_diffuse.py",)}
+_LTC_BRDF_SOURCES["ltc_disney_sheen"] = ("core/cloth.py",)
 
 #: LTC lobes: table prefix -> (lobe name in core.ltc.fit_lobes, description)
 LTC_LOBES = {
@@ -95,11 +100,26 @@ LTC_LOBES = {
     "ltc_cod_diffuse": ("cod_diffuse", "Call of Duty WWII multiscattering diffuse (albedo 1)"),
     "ltc_cloth": ("cloth", "Ashikhmin velvet + Neubelt-Pettineo visibility (colour 1)"),
     "ltc_oren_nayar": ("oren_nayar", "Fujii's improved Oren-Nayar single scattering (albedo 1)"),
+    "ltc_disney_sheen": ("disney_sheen", "Disney sheen (1 - l.h)^5 (colour 1; no roughness: every column alike)"),
 }
 
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
     GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=dict(LTC_FIT, lobe=_lobe),
                                 sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_prefix, ()))
+
+#: Cycles' sheen (Zeltner, Burley & Chiang 2022): the LTC (a, b) and albedo of each (mu, r), measured from
+#: Cycles renders (validation/sheen_table.py); 32 x 32 nodes at i/31 as Cycles' own table, so a bilinear
+#: lookup reproduces Cycles' exactly.  ``params`` say what was measured, with which Blender.
+ZELTNER_SHEEN_SIZE = 32
+#: Measured groups, apart from ``GROUPS`` (what ``core.lut_bake`` computes): ``keep_measured`` keeps them.
+MEASURED_GROUPS = {}
+MEASURED_GROUPS["zeltner_sheen"] = BakeGroup(
+    name="zeltner_sheen", generator_version=1,
+    params={"size": ZELTNER_SHEEN_SIZE, "source": "Cycles Sheen BSDF (Microfiber), Blender 5.2.3",
+            "method": "sun (angle 0) renders, 1 sample, direct light; linear least squares per cell",
+            "paper": "Zeltner, Burley, Chiang 2022, Practical Multiple-Scattering Sheen Using LTCs",
+            "derived": "zeltner_sheen_sh1/sh2: moments of each cell's LTC, 128 x 256 product rule (sh_moments)"},
+    sources=(), measured=True, command="python scripts/measure_sheen_table.py")
 
 LTC_INV_CHANNELS = ("R = c0 = Minv_xx, G = c1 = Minv_zx, B = c2 = Minv_xz, A = c3 = Minv_zz "
                     "(Minv normalised so that Minv_yy = 1)")
@@ -130,6 +150,22 @@ TABLES = {
                         "scale + bias = E from the same samples"),
     )
 }
+TABLES["zeltner_sheen"] = TableSpec(
+    name="zeltner_sheen", filename="zeltner_sheen.exr", group="zeltner_sheen",
+    width=ZELTNER_SHEEN_SIZE, height=ZELTNER_SHEEN_SIZE,
+    channels="R = a, G = b (LTC inverse matrix [[a, 0, b], [0, a, 0], [0, 0, 1]]), B = albedo; A = 1",
+    description="Zeltner 2022 sheen as Cycles shades it (measured from Cycles): f cos = albedo x the LTC's "
+                "density; sheen roughness clamped to [1e-3, 1]",
+    axis_u="u: sheen roughness r (Cycles clamps it to >= 1e-3); node i at r = i/(W-1), texel centre (i+0.5)/W",
+    axis_v=AXIS_V_MU)
+for _name, _channels in (("zeltner_sheen_sh1", "R = E[x], G = E[z], B = E[x z]; A = 1"),
+                          ("zeltner_sheen_sh2", "R = E[x^2], G = E[y^2], B = E[z^2]; A = 1")):
+    TABLES[_name] = TableSpec(
+        name=_name, filename=_name + ".exr", group="zeltner_sheen", width=ZELTNER_SHEEN_SIZE,
+        height=ZELTNER_SHEEN_SIZE, channels=_channels,
+        description="moments of the Zeltner sheen's normalised LTC per (mu, r) in the local frame (N = +Z, V towards "
+                    "+X), derived from zeltner_sheen: the world term's exact L2 SH integral",
+        axis_u=TABLES["zeltner_sheen"].axis_u, axis_v=AXIS_V_MU)
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
     TABLES[_prefix + "_inv"] = TableSpec(
         name=_prefix + "_inv", filename=_prefix + "_inv.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
@@ -183,10 +219,15 @@ def code_text(path):
     return "\n".join(kept)
 
 
+def bake_group(name):
+    """The ``BakeGroup`` called ``name``, computed (``GROUPS``) or measured (``MEASURED_GROUPS``)."""
+    return GROUPS[name] if name in GROUPS else MEASURED_GROUPS[name]
+
+
 def inputs_hash(group_name):
     """Hash of everything that determines a bake group's values: parameters and the code (without
     comments and docstrings: ``code_text``) of the modules that compute it."""
-    group = GROUPS[group_name]
+    group = bake_group(group_name)
     h = hashlib.sha256()
     h.update(json.dumps({"layout": LAYOUT_VERSION, "group": group.name,
                          "generator": group.generator_version, "params": group.params},
@@ -210,9 +251,9 @@ def table_status(spec, lut_dir, expected_hash=None):
     try:
         _, meta = exr_io.read_table(path, expected_table=spec.name, expected_shape=spec.shape)
     except exr_io.LutMissingError as exc:
-        return LutStatus(spec.name, path, "missing", str(exc))
+        return LutStatus(spec.name, path, "missing", _measured_hint(spec, str(exc)))
     except exr_io.LutCorruptError as exc:
-        return LutStatus(spec.name, path, "corrupt", str(exc))
+        return LutStatus(spec.name, path, "corrupt", _measured_hint(spec, str(exc)))
     except exr_io.LutMismatchError as exc:
         return LutStatus(spec.name, path, "mismatch", str(exc))
     if meta.get("layout_version") != LAYOUT_VERSION:
@@ -220,6 +261,11 @@ def table_status(spec, lut_dir, expected_hash=None):
                          f"{path}: layout version {meta.get('layout_version')}, this code reads "
                          f"{LAYOUT_VERSION}. Re-bake with `{exr_io.BAKE_COMMAND} --force`.")
     expected_hash = expected_hash or inputs_hash(spec.group)
+    group = bake_group(spec.group)
+    if group.measured and meta.get("inputs_hash") != expected_hash:
+        return LutStatus(spec.name, path, "stale",
+                         f"{path}: a measured table from other inputs than the catalog's ({group.params}). "
+                         f"It is not baked: re-measure with `{group.command}` or restore the shipped file.")
     if meta.get("inputs_hash") != expected_hash:
         return LutStatus(spec.name, path, "stale",
                          f"{path}: baked from other inputs than the current code and settings. "
@@ -227,8 +273,45 @@ def table_status(spec, lut_dir, expected_hash=None):
     return LutStatus(spec.name, path, "ok", f"{path.name}: ok")
 
 
+def _measured_hint(spec, message):
+    """A measured table's missing / corrupt message: it cannot be baked, say how to get it back."""
+    group = bake_group(spec.group)
+    if not group.measured:
+        return message
+    return (f"{message.split(' Re-bake')[0]} This table is measured, not baked (scripts/bake_luts.py copies "
+            f"the shipped one, {default_lut_dir() / spec.filename}): restore that file or re-measure it with "
+            f"`{group.command}` (needs Blender's Cycles).")
+
+
 def lut_status(lut_dir=None):
     """Status of every table in ``lut_dir`` (default: the shipped folder)."""
     lut_dir = Path(lut_dir) if lut_dir is not None else default_lut_dir()
-    hashes = {g: inputs_hash(g) for g in GROUPS}
+    hashes = {g: inputs_hash(g) for g in list(GROUPS) + list(MEASURED_GROUPS)}
     return [table_status(spec, lut_dir, hashes[spec.group]) for spec in TABLES.values()]
+
+
+def keep_measured(lut_dir, log=print):
+    """Measured tables are never computed by the bake (``core.lut_bake`` knows only ``GROUPS``): in
+    ``lut_dir`` each is kept when current, else copied from the shipped folder when that one is intact;
+    otherwise ``log`` says how to get it back.  Returns {group: "kept" | "copied" | "missing"}."""
+    import shutil
+
+    out = {}
+    shipped = default_lut_dir()
+    for name, group in MEASURED_GROUPS.items():
+        specs = [s for s in TABLES.values() if s.group == name]
+        ok = lambda folder: all(table_status(s, folder).state == "ok" for s in specs)   # noqa: E731
+        if ok(lut_dir):
+            out[name] = "kept"
+        elif Path(lut_dir).resolve() != shipped.resolve() and ok(shipped):
+            Path(lut_dir).mkdir(parents=True, exist_ok=True)
+            for spec in specs:
+                shutil.copyfile(shipped / spec.filename, Path(lut_dir) / spec.filename)
+            out[name] = "copied"
+        else:
+            out[name] = "missing"
+        if out[name] != "missing":
+            log(f"[bake] {name}: measured table, {out[name]} ({', '.join(s.filename for s in specs)})")
+        for spec in specs if out[name] == "missing" else ():
+            log(f"[bake] {name}: {table_status(spec, lut_dir).message}")
+    return out

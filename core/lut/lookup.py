@@ -138,6 +138,33 @@ class LutSet(Mapping):
         return (tuple(op.lut_sample(inv, u, v, i) for i in range(4)),
                 op.lut_sample(mag, u, v, 0), op.lut_sample(mag, u, v, 1))
 
+    # -- Zeltner 2022 sheen, as Cycles shades it (core/sheen.py) ------------------------------------
+    def zeltner_sheen(self, mu, roughness):
+        """(a, b, albedo) of the sheen LTC at (mu, r) (table zeltner_sheen; r is the caller's, clamped as
+        Cycles does by ``core.sheen.zeltner_roughness``); nodes at i/31 on both axes, as Cycles' table."""
+        size = catalog.ZELTNER_SHEEN_SIZE
+        u, v = lut_coordinate(roughness, size), lut_coordinate(mu, size)
+        table = self["zeltner_sheen"]
+        if not is_expr(u, v):
+            m = sample_bilinear(table.require_data(), u, v)
+            return m[..., 0], m[..., 1], m[..., 2]
+        return tuple(op.lut_sample(table, u, v, i) for i in range(3))
+
+    def zeltner_sheen_moments(self, mu, roughness):
+        """((E[x], E[z], E[x z]), (E[x^2], E[y^2], E[z^2])) of the sheen LTC at (mu, r) in the local frame
+        (tables zeltner_sheen_sh1, zeltner_sheen_sh2; r clamped by the caller as for ``zeltner_sheen``)."""
+        size = catalog.ZELTNER_SHEEN_SIZE
+        u, v = lut_coordinate(roughness, size), lut_coordinate(mu, size)
+        out = []
+        for name in ("zeltner_sheen_sh1", "zeltner_sheen_sh2"):
+            table = self[name]
+            if not is_expr(u, v):
+                m = sample_bilinear(table.require_data(), u, v)
+                out.append((m[..., 0], m[..., 1], m[..., 2]))
+            else:
+                out.append(tuple(op.lut_sample(table, u, v, i) for i in range(3)))
+        return tuple(out)
+
     def sphere_table(self, prefix="ltc_ggx"):
         """The horizon-clipped sphere table: the ``prefix_mag`` table, whose channel A
         (``core.ltc.sphere_table.SPHERE_CHANNEL``) holds it on its own axes; every ``*_mag`` table

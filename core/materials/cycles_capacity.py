@@ -27,12 +27,16 @@ _SPECULAR_COST = {"none": 0, "single": 0, "turquin": 1, "fdez_aguera": 1, "kulla
 #: cod_wrapped: the CoD lobe plus the wrapped normal's tilt, costlier than either (no measured set bounds it yet,
 #: so it takes the smallest measured capacity).
 _DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1, "cod_wrapped": 2}
+#: The fitted Disney sheen has the talk's structure (one LTC integral, another table).  Zeltner's (turquin, cod)
+#: renders 64 quad lights, with and without the World term (the benchmark's cap; docs/sheen.md, "Cost"), so the
+#: talk's sheen's measured set bounds it too.
+_SHEEN_COST = {"none": 0, "disney_talk": 1, "disney_fitted": 1, "zeltner": 1}
 
 
 def _at_least_as_costly(measured, features):
     return (_SPECULAR_COST[measured.specular] >= _SPECULAR_COST[features.specular]
             and _DIFFUSE_COST[measured.diffuse] >= _DIFFUSE_COST[features.diffuse]
-            and measured.sheen >= features.sheen and measured.cloth >= features.cloth)
+            and _SHEEN_COST[measured.sheen] >= _SHEEN_COST[features.sheen] and measured.cloth >= features.cloth)
 
 
 def light_capacity(features, world=False):

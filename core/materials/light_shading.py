@@ -75,9 +75,31 @@ def combine_lobes(features, surface, lobe_values, light_color, area=False):
     total = spec + op.scale(surface["Albedo"], lobe_values["Diffuse"])
     if features.diffuse == "oren_nayar":
         total = total + _rough_diffuse_multiscatter(surface, lobe_values)
-    if features.sheen:
-        total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
-    return op.vmul(light_color, total)
+    return op.vmul(light_color, add_sheen(features, surface, lobe_values, total))
+
+
+def add_sheen(features, surface, lobe_values, below):
+    """``below`` (the lobes under the sheen) plus the sheen lobe.  The Disney sheens add (Burley 2012, the
+    talk); Zeltner's is layered as the Principled BSDF does (Cycles' ``principled_bsdf_emission``): the
+    lobes below are weighted by 1 - max(sheen colour) x R(mu_v), R the sheen's directional albedo."""
+    if features.sheen == "none":
+        return below
+    return layer_sheen(features, surface, below, op.scale(surface["Sheen Color"], lobe_values["Sheen"]),
+                       lobe_values.get("Sheen Albedo"))
+
+
+def layer_sheen(features, surface, below, sheen, albedo):
+    """``below`` under the sheen radiance ``sheen`` (colour applied); ``albedo`` R(mu_v) (Zeltner's only)."""
+    if features.sheen == "zeltner":
+        below = op.scale(below, sheen_layer_weight(surface["Sheen Color"], albedo))
+    return below + sheen
+
+
+def sheen_layer_weight(sheen_color, albedo):
+    """Cycles' ``closure_layering_weight`` for the Principled sheen: saturate(1 - max_c(colour_c) R)."""
+    c = op.maximum(op.maximum(op.component(sheen_color, 0), op.component(sheen_color, 1)),
+                   op.component(sheen_color, 2))
+    return op.saturate(1.0 - c * albedo)
 
 
 def _without_specular(features, surface, lobe_values, light_color):
@@ -88,9 +110,7 @@ def _without_specular(features, surface, lobe_values, light_color):
         total = total + _rough_diffuse_multiscatter(surface, lobe_values)
     if features.cloth:
         total = total + op.scale(op.scale(surface["Cloth Color"], lobe_values["Cloth"]), surface["Cloth Weight"])
-    if features.sheen:
-        total = total + op.scale(surface["Sheen Color"], lobe_values["Sheen"])
-    return op.vmul(light_color, total)
+    return op.vmul(light_color, add_sheen(features, surface, lobe_values, total))
 
 
 def _rough_diffuse_multiscatter(surface, lobe_values):
@@ -107,10 +127,13 @@ def lobe_keys(features):
         keys.append("kulla_conty")
     if features.cloth:
         keys.append("cloth")
-    if features.sheen:
-        keys.append("sheen")
+    if features.sheen != "none":
+        keys.append(SHEEN_LOBES[features.sheen])
     return keys
 
+
+#: Sheen model -> its lobe (``lobes.LOBES``).
+SHEEN_LOBES = {"disney_talk": "sheen", "zeltner": "zeltner", "disney_fitted": "disney_fitted"}
 
 #: The surface terms a light's shading reads (``shade_surface``: those of one feature set).
 SHADE_SURFACE = ("N", "V", "Roughness", "F0", "Albedo", "Wrap", "Sheen Color", "Cloth Weight", "Cloth Color")
@@ -133,6 +156,10 @@ def shade_surface(features):
     if features.diffuse == "oren_nayar":
         terms += tuple(k for k in ROUGH_DIFFUSE_SURFACE if k not in terms)
     return terms
+
+
+#: Surface terms only some lobes read (a shade function has them only when one of its lobes does).
+OPTIONAL_SURFACE = ("Sheen Roughness",)
 
 
 def light_color_name(kind):
@@ -158,7 +185,7 @@ def shade_function(kind, features):
         return {"Radiance": combine_lobes(features, kw, values, kw[color_name], kind in lobes.AREA_KINDS)}
 
     surface_terms = shade_surface(features)
-    inputs = {k: SURFACE_OUTPUTS[k] for k in surface_terms}
+    inputs = {k: SURFACE_OUTPUTS[k] for k in surface_terms + tuple(k for k in OPTIONAL_SURFACE if k not in surface_terms)}
     if kind in lobes.AREA_KINDS + ("point", "spot", "quad_spot"):
         inputs["Position"] = GEOMETRY_INPUTS["Position"]
     inputs.update(lobes.light_geometry_sockets(kind))

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import cloth, diffuse, lights, microfacet, multiscatter, rough_diffuse
+from .. import cloth, diffuse, lights, microfacet, multiscatter, rough_diffuse, sheen
 from .. import shading_ops as op
 from ..conventions import alpha_from_roughness
 from ..ir.functions import NodeFunction
@@ -40,6 +40,7 @@ _L = vector("Unit direction towards the light", "NONE", hide_value=True)
 _P = vector("Shading point, world space", "NONE", hide_value=True)
 _PARAMETERS = {"Roughness": factor(0.5, "Blender roughness r"), "Wrap": factor(0.0, "Wrapped-diffuse amount w")}
 _PARAMETERS["Diffuse Roughness"] = factor(0.0, "Diffuse roughness sigma (Principled's Diffuse Roughness)")
+_PARAMETERS["Sheen Roughness"] = factor(0.5, "Sheen roughness (Principled's), clamped to [1e-3, 1] as Cycles")
 _OUT = Socket("float", 0.0, description="Per unit incident irradiance, cosine included")
 _SPEC_OUT = {
     "Scale": Socket("float", 0.0, description="Multiplies F0 (Schlick, F90 = 1)"),
@@ -238,6 +239,46 @@ SHEEN = Lobe("sheen", "Sheen", (), {"Sheen": _OUT}, _sheen_punctual, _sheen_area
              "Disney sheen (1 - l.h)^5 times the cosine", "Disney sheen via the CoD table at r = 0.5 (the talk)")
 
 
+# --- Zeltner 2022 sheen (Blender's Principled sheen; core/sheen.py) ----------------------------------
+# Punctual: the LTC's density at L times the albedo, exactly Cycles' closure.  Area: the same LTC's integral
+# over the light (core/ltc/shading.zeltner_sheen).  Both return the albedo R(mu_v) too, for the layering of
+# the lobes below the sheen (Principled: their weight times 1 - max(sheen colour) R).
+
+_ZELTNER_OUT = {"Sheen": _OUT, "Sheen Albedo": scalar(0.0, "Directional albedo R(mu_v) of the sheen lobe")}
+
+
+def _zeltner_punctual(tables, N, V, L, **kw):
+    t1, t2, n = shading.polygon.local_frame(N, V)
+    a, b, albedo = tables.zeltner_sheen(op.saturate(op.dot(N, V)), sheen.zeltner_roughness(kw["Sheen Roughness"]))
+    keep = op.logical_and(sheen.zeltner_active(a, albedo), op.greater(op.dot(N, V), 0.0))
+    value = sheen.zeltner_density(op.dot(L, t1), op.dot(L, t2), op.dot(L, n), a, b) * albedo
+    return {"Sheen": op.select(keep, value, 0.0), "Sheen Albedo": op.select(keep, albedo, 0.0)}
+
+
+def _zeltner_area(tables, light, Position, N, V, **kw):
+    value, albedo = shading.zeltner_sheen(tables, light, Position, N, V, kw["Sheen Roughness"])
+    return {"Sheen": value, "Sheen Albedo": albedo}
+
+
+ZELTNER = Lobe("zeltner", "Zeltner Sheen", ("Sheen Roughness",), _ZELTNER_OUT, _zeltner_punctual, _zeltner_area,
+               "Zeltner 2022 sheen (Cycles' Principled sheen): its LTC density times the albedo",
+               "Zeltner 2022 sheen over the light: its own LTC's integral times the albedo",
+               reads_tables_punctual=True)
+
+
+# --- Disney sheen with its own fitted LTC (core/ltc/fit_lobes.py "disney_sheen") ----------------------
+# Punctual: Burley 2012's (1 - l.h)^5 times the cosine, as SHEEN; area: the fitted table's LTC integral times its
+# magnitude (the lobe has no roughness: the table's columns are one fit).
+
+def _disney_fitted_area(tables, light, Position, N, V):
+    return {"Sheen": shading.disney_sheen_fitted(tables, light, Position, N, V, 1.0)}
+
+
+DISNEY_FITTED = Lobe("disney_fitted", "Disney Sheen Fitted", (), {"Sheen": _OUT}, _sheen_punctual,
+                     _disney_fitted_area, "Disney sheen (1 - l.h)^5 times the cosine",
+                     "Disney sheen over the light with its own fitted LTC")
+
+
 # --- rough diffuse as Cycles: Fujii's improved Oren-Nayar + EON's multiple scattering (core/rough_diffuse.py) ---
 # "Diffuse" is the single-scattering part with albedo 1, "Diffuse MS" the multiple-scattering lobe with colour 1,
 # (1 - E_F(mu_v)) ms_kernel(mu_l); light_shading.combine_lobes applies the albedo and rough_diffuse.multiscatter_color.
@@ -281,6 +322,7 @@ OREN_NAYAR = Lobe("oren_nayar", "Oren-Nayar", ("Diffuse Roughness",), _OREN_NAYA
 #: Every lobe, by key, in Add > Group order.
 LOBES = {lobe.key: lobe for lobe in (GGX, KULLA_CONTY, LAMBERT, COD, WRAPPED, COD_WRAPPED, CLOTH, SHEEN)}
 LOBES[OREN_NAYAR.key] = OREN_NAYAR
+LOBES.update({lobe.key: lobe for lobe in (ZELTNER, DISNEY_FITTED)})
 
 
 # --- node functions -----------------------------------------------------------------------------------

@@ -25,6 +25,10 @@ DIFFUSE_MODELS = ("lambert", "cod", "wrapped", "cod_wrapped")
 #: "oren_nayar": rough diffuse as Cycles shades Principled's Diffuse Roughness (Fujii's improved Oren-Nayar with
 #: EON's energy-preserving multiple scattering; core/rough_diffuse.py), read from the "Diffuse Roughness" input.
 DIFFUSE_MODELS += ("oren_nayar",)
+#: The sheen lobe: none; Zeltner, Burley & Chiang 2022 (Blender's Principled sheen, core/sheen.py); Disney
+#: sheen (Burley 2012) with its own fitted LTC under area lights; Disney sheen as the talk shades it (the CoD
+#: table at r = 0.5 under area lights).  A stored ``sheen: true`` (the old switch) is "disney_talk".
+SHEEN_MODELS = ("none", "zeltner", "disney_fitted", "disney_talk")
 #: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
 #: the prefiltered radiance (the talk's approximation); core/materials/world.py.
 ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")
@@ -45,6 +49,8 @@ RT_LIT_INPUTS = {
     "Diffuse Roughness": factor(0.0, "Oren-Nayar roughness sigma, as Principled's Diffuse Roughness (used when the "
                                      "diffuse model is 'oren_nayar')", "Diffuse"),
     "Sheen Weight": factor(0.0, "Disney sheen amount (used when sheen is switched on)", "Sheen"),
+    "Sheen Roughness": factor(0.5, "Sheen roughness (Zeltner sheen, as Principled's; the Disney sheens ignore it)",
+                              "Sheen"),
     "Sheen Tint": color((1.0, 1.0, 1.0, 1.0), "Colour of the Disney sheen", "Sheen"),
     "Cloth Weight": factor(0.0, "Blend from the specular lobe to the Ashikhmin cloth lobe (cloth switched on)",
                            "Cloth"),
@@ -76,6 +82,7 @@ SURFACE_OUTPUTS = {
     "Wrap": factor(0.0, "Wrapped-diffuse amount"),
     "Diffuse Roughness": factor(0.0, "Diffuse (Oren-Nayar) roughness sigma"),
     "Sheen Color": color((0.0, 0.0, 0.0), "Sheen weight times tint"),
+    "Sheen Roughness": factor(0.5, "Sheen roughness"),
     "Cloth Weight": factor(0.0, "Blend from specular to cloth"),
     "Cloth Color": color((1.0, 1.0, 1.0), "Cloth colour"),
     "Emission": color((0.0, 0.0, 0.0), "Emitted radiance"),
@@ -130,11 +137,15 @@ class Features:
     """Build-time switches of an RT Lit group."""
     specular: str = "turquin"        # one of SPECULAR_MODELS
     diffuse: str = "cod"             # one of DIFFUSE_MODELS
-    sheen: bool = False
+    sheen: str = "none"              # one of SHEEN_MODELS (True / False: "disney_talk" / "none")
     cloth: bool = False
     environment_ms: str = "irradiance"   # one of ENVIRONMENT_MS_FORMS (Fdez-Aguera under the world)
 
     def __post_init__(self):
+        if isinstance(self.sheen, (bool, int)):       # the old switch (stored materials, Features(sheen=True))
+            object.__setattr__(self, "sheen", "disney_talk" if self.sheen else "none")
+        if self.sheen not in SHEEN_MODELS:
+            raise ValueError(f"sheen model must be one of {SHEEN_MODELS}, got {self.sheen!r}")
         if self.specular not in SPECULAR_MODELS:
             raise ValueError(f"specular model must be one of {SPECULAR_MODELS}, got {self.specular!r}")
         if self.diffuse not in DIFFUSE_MODELS:
@@ -154,5 +165,11 @@ class Features:
         parts = ["no specular" if self.specular == "none" else self.specular.replace("_", "-"), self.diffuse]
         if self.specular == "fdez_aguera" and self.environment_ms != "irradiance":
             parts[0] += f" ({self.environment_ms})"
-        parts += [p for p, on in (("sheen", self.sheen), ("cloth", self.cloth)) if on]
+        parts += [p for p, on in ((_SHEEN_LABELS[self.sheen], self.sheen != "none"), ("cloth", self.cloth)) if on]
         return ", ".join(parts)
+
+
+#: Sheen model -> its word in group names ("disney_talk" keeps the old switch's "sheen", so the groups of
+#: materials saved before the sheen models keep their names).
+_SHEEN_LABELS = {"none": "", "zeltner": "zeltner sheen", "disney_fitted": "disney-fitted sheen",
+                 "disney_talk": "sheen"}

@@ -62,6 +62,7 @@ def _surface(**kw):
         "Wrap": op.saturate(kw["Wrap"]),
         "Diffuse Roughness": op.saturate(kw["Diffuse Roughness"]),
         "Sheen Color": op.scale(_reflectance(kw["Sheen Tint"]), op.saturate(kw["Sheen Weight"])),
+        "Sheen Roughness": op.saturate(kw["Sheen Roughness"]),
         "Cloth Weight": op.saturate(kw["Cloth Weight"]),
         "Cloth Color": _reflectance(kw["Cloth Color"]),
         "Emission": _emission(kw["Emission Color"], kw["Emission Strength"]),

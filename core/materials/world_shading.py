@@ -50,7 +50,7 @@ import numpy as np
 
 from pathlib import Path
 
-from .. import indirect, multiscatter, rough_diffuse
+from .. import indirect, multiscatter, rough_diffuse, sheen
 from .. import shading_ops as op
 from ..conventions import alpha_from_roughness
 from ..fresnel import fresnel_average
@@ -60,6 +60,7 @@ from ..ir.tables import Table
 from ..ltc import polygon
 from ..ltc import shading as ltc_shading
 from ..lut.lookup import REFERENCES
+from .light_shading import layer_sheen
 from .rt_lit_interface import SURFACE_OUTPUTS, world_input
 
 PI = math.pi
@@ -299,6 +300,76 @@ def _rough_diffuse_multiscatter_world(coeffs, n, surface, ms_weight):
     lobe = sh_lobe(coeffs, n, rough_diffuse.MS_KERNEL_ZONAL)
     color = rough_diffuse.multiscatter_color(surface["Albedo"], surface["Metal F0"], surface["Diffuse Roughness"])
     return op.scale(op.vmul(color, lobe), ms_weight)
+# Zeltner 2022 sheen under the world (core/sheen.py): its exact integral against the L2 SH radiance.  L2 radiance
+# is a polynomial of degree 2 in the direction, so int L D = sum_i c_i E_D[Y_i] needs only D's first and second
+# moments (tables zeltner_sheen_sh1/2, computed per cell from the measured LTC: validation/sheen_table.py), taken
+# from the local frame (T1, T2, N) to the world's here.  Against Cycles under two studio HDRIs (docs/sheen.md):
+# median 21% (studio, r = 0.5) and 7.9% (sunset, r = 0.2) where the talk's cosine lobe about the LTC's peak gave
+# 49% and 28%; what remains is the L2 truncation of the environment.
+def _zeltner_world_lobe(tables, **kw):
+    n, v = kw["N"], kw["V"]
+    mu, r = op.saturate(op.dot(n, v)), sheen.zeltner_roughness(kw["Sheen Roughness"])
+    a, _, albedo = tables.zeltner_sheen(mu, r)
+    (mx, mz, mxz), (mxx, myy, mzz) = tables.zeltner_sheen_moments(mu, r)
+    keep = op.logical_and(sheen.zeltner_active(a, albedo), op.greater(op.dot(n, v), 0.0))
+    t1, t2, nn = polygon.local_frame(n, v)
+
+    def second(i, j):
+        """E[w_i w_j] in world coordinates: sum over the local axes (only xx, yy, zz and xz are non-zero)."""
+        t1i, t1j, t2i, t2j = op.component(t1, i), op.component(t1, j), op.component(t2, i), op.component(t2, j)
+        ni, nj = op.component(nn, i), op.component(nn, j)
+        return mxx * t1i * t1j + myy * t2i * t2j + mzz * ni * nj + mxz * (t1i * nj + ni * t1j)
+
+    out = {"Mean": op.scale(t1, mx) + op.scale(nn, mz), "Albedo": op.select(keep, albedo, 0.0)}
+    out.update({name: second(i, j) for name, (i, j) in SECOND_MOMENTS.items()})
+    return out
+
+
+#: World second moments E[w_i w_j] the SH integral needs, by output name.
+SECOND_MOMENTS = {"XX": (0, 0), "YY": (1, 1), "ZZ": (2, 2), "XY": (0, 1), "YZ": (1, 2), "XZ": (0, 2)}
+
+SH_LTC_ZELTNER = NodeFunction(
+    "RTL SH-LTC Zeltner Sheen", _zeltner_world_lobe,
+    {"N": _DIR, "V": _DIR, "Sheen Roughness": factor(0.5, "Sheen roughness")},
+    dict({"Mean": vector("E[w] of the sheen's normalised LTC, world space", "NONE")},
+         **{k: Socket("float", 0.0, description=f"E[w_{k[0].lower()} w_{k[1].lower()}], world space")
+            for k in SECOND_MOMENTS},
+         Albedo=Socket("float", 0.0, description="Directional albedo R(mu_v) (0 where Cycles drops the lobe)")),
+    "Zeltner sheen's LTC: its moments in world space and its albedo", tables=REFERENCES)
+
+
+# Ramamoorthi & Hanrahan 2001, eq. 3: each basis function is a polynomial of degree <= 2, so its expectation
+# under a distribution is the same polynomial of the moments.
+def _sh_moments(**kw):
+    coeffs = [kw[name] for name in SH_NAMES]
+    m = kw["Mean"]
+    e = {k: kw[k] for k in SECOND_MOMENTS}
+    x, y, z = (op.component(m, i) for i in range(3))
+    expectations = (indirect.Y00 + 0.0 * x, indirect.Y1 * y, indirect.Y1 * z, indirect.Y1 * x,
+                    indirect.Y2_PRODUCT * e["XY"], indirect.Y2_PRODUCT * e["YZ"], indirect.Y20 * (3.0 * e["ZZ"] - 1.0),
+                    indirect.Y2_PRODUCT * e["XZ"], indirect.Y22 * (e["XX"] - e["YY"]))
+    total = op.scale(coeffs[0], expectations[0])
+    for c, ey in zip(coeffs[1:], expectations[1:]):
+        total = total + op.scale(c, ey)
+    return {"Radiance": total}
+
+
+SH_MOMENTS = NodeFunction(
+    "RTL SH Moments", _sh_moments,
+    {**{name: WORLD_PARAMETERS[name] for name in SH_NAMES}, "Mean": vector("E[w]", "NONE", hide_value=True),
+     **{k: Socket("float", 0.0, description=f"E[w_{k[0].lower()} w_{k[1].lower()}]") for k in SECOND_MOMENTS}},
+    {"Radiance": color((0.0, 0.0, 0.0), "int L(w) D(w) dw for the distribution D with these moments")},
+    "L2 SH environment integrated against a distribution given by its first and second moments")
+
+
+def sh_moments(coeffs, lobe):
+    """int L D for the SH ``coeffs`` (9 colours) and the moments of D (``SH_LTC_ZELTNER``'s outputs)."""
+    kw = dict(zip(SH_NAMES, coeffs))
+    return SH_MOMENTS(**kw, Mean=lobe["Mean"], **{k: lobe[k] for k in SECOND_MOMENTS})["Radiance"]
+
+
+SH_LTC_DISNEY_FITTED = _ltc_lobe_function("Disney Sheen Fitted", "ltc_disney_sheen",
+                                          "Disney sheen's own fitted LTC: lobe axis and magnitude", 0.0)
 
 
 # --- specular ---------------------------------------------------------------------------------------
@@ -362,8 +433,10 @@ WORLD_SURFACE = ("N", "V", "Roughness", "Dielectric F0", "Metal F0", "Metallic",
 
 
 def world_surface(features):
-    """The surface terms the world term of ``features`` reads (the rough diffuse adds its roughness)."""
-    return WORLD_SURFACE + (("Diffuse Roughness",) if features.diffuse == "oren_nayar" else ())
+    """The surface terms the world term of ``features`` reads (``WORLD_SURFACE``; the rough diffuse adds its
+    roughness, Zeltner's sheen the sheen roughness)."""
+    return (WORLD_SURFACE + (("Diffuse Roughness",) if features.diffuse == "oren_nayar" else ())
+            + (("Sheen Roughness",) if features.sheen == "zeltner" else ()))
 
 
 def world_radiance(tables, features, env, surface, params):
@@ -406,10 +479,15 @@ def world_radiance(tables, features, env, surface, params):
         total = total + _rough_diffuse_multiscatter_world(coeffs, n, surface, rough["MS Weight"])
     if spec is not None:
         total = spec + total
-    if features.sheen:
-        lobe = SH_LTC_SHEEN(tables, N=n, V=v)
-        sheen = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
-        total = total + op.vmul(surface["Sheen Color"], sheen)
+    if features.sheen != "none":
+        if features.sheen == "zeltner":
+            lobe = SH_LTC_ZELTNER(tables, N=n, V=v, **{"Sheen Roughness": surface["Sheen Roughness"]})
+            sheen_lobe = op.scale(sh_moments(coeffs, lobe), lobe["Albedo"])
+        else:
+            lobe = (SH_LTC_SHEEN if features.sheen == "disney_talk" else SH_LTC_DISNEY_FITTED)(tables, N=n, V=v)
+            sheen_lobe = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
+        total = layer_sheen(features, surface, total, op.vmul(surface["Sheen Color"], sheen_lobe),
+                            lobe["Albedo"] if features.sheen == "zeltner" else None)
     return op.scale(total, params["Strength"])
 
 

@@ -196,7 +196,8 @@ def test_round_trip_is_lossless(bpy_module, convert, factory):
 
     result = convert.principled_to_rt_lit(mat, factory)
     assert set(result.ignored_inputs) == {"Alpha", "Subsurface Weight", "Transmission Weight", "Coat Weight"}
-    assert convert.stored_features(mat) == Features()
+    converted = Features(sheen="zeltner")         # the material has Sheen Weight 0.4: Blender's own sheen
+    assert convert.stored_features(mat) == converted
 
     back = convert.rt_lit_to_principled(mat)
     assert back.status == "converted" and not back.warnings
@@ -208,8 +209,8 @@ def test_round_trip_is_lossless(bpy_module, convert, factory):
     assert "RT Lit" not in tree.nodes and not any(n.bl_idname == "NodeFrame" for n in tree.nodes)
     assert all(k not in p for k in ("rtl_role", "rtl_location", "rtl_parent", "rtl_hide"))
     # The RT Lit group datablock is left alone; the material still remembers its switches.
-    assert set(bpy_module.data.node_groups.keys()) >= groups | {factory(Features()).name}
-    assert convert.stored_features(mat) == Features()
+    assert set(bpy_module.data.node_groups.keys()) >= groups | {factory(converted).name}
+    assert convert.stored_features(mat) == converted
 
 
 def test_edits_made_in_rt_lit_survive(bpy_module, convert, factory):
@@ -461,6 +462,12 @@ def test_sheen_off_with_a_sheen_material_says_so(bpy_module, convert, factory):
     assert convert.principled_uses_sheen(mat)
     result = convert.principled_to_rt_lit(mat, factory, Features(sheen=False))
     assert any("Sheen Weight 0.4 is not shaded" in w and "Sheen on" in w for w in result.warnings)
+    # without explicit switches a Principled material with sheen gets Blender's own sheen, Sheen Roughness mapped
+    velvet = _principled_material(bpy_module, "Velvet 2")
+    principled = next(n for n in velvet.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    principled.inputs["Sheen Roughness"].default_value = 0.25
+    assert convert.principled_to_rt_lit(velvet, factory).features.sheen == "zeltner"
+    assert convert.find_rt_lit_node(velvet).inputs["Sheen Roughness"].default_value == pytest.approx(0.25)
     plain = _new_material(bpy_module, "Plain")
     assert not convert.principled_uses_sheen(plain)
     assert not any("Sheen" in w for w in convert.principled_to_rt_lit(plain, factory, Features()).warnings)
@@ -477,16 +484,18 @@ def test_switches_in_the_panel_rebuild_the_group(bpy_module, empty_scene, lut_di
         mat = _principled_material(bpy_module, "Switchable")
         convert.principled_to_rt_lit(mat, convert.default_group_factory(lut_dir), Features("turquin", "cod"))
         switches = mat.rtl_switches
-        assert (switches.specular, switches.diffuse, switches.sheen) == ("turquin", "cod", False)
+        assert (switches.specular, switches.diffuse, switches.sheen) == ("turquin", "cod", "none")
         rt = convert.find_rt_lit_node(mat)
         roughness = rt.inputs["Roughness"].default_value
-        switches.sheen = True
+        switches.sheen = "zeltner"
         switches.specular = "kulla_conty"
-        assert convert.stored_features(mat) == Features("kulla_conty", "cod", sheen=True)
+        assert convert.stored_features(mat) == Features("kulla_conty", "cod", sheen="zeltner")
         rt = convert.find_rt_lit_node(mat)
-        assert "kulla-conty, cod, sheen" in rt.node_tree.name
+        assert "kulla-conty, cod, zeltner sheen" in rt.node_tree.name
         assert rt.inputs["Roughness"].default_value == roughness and rt.inputs["Base Color"].is_linked
-        assert (switches.specular, switches.sheen) == ("kulla_conty", True)
+        assert (switches.specular, switches.sheen) == ("kulla_conty", "zeltner")
+        mat["rtl_features"]["sheen"] = 1           # a file saved with the old switch: the talk's Disney sheen
+        assert switches.sheen == "disney_talk"
     finally:
         addon.unregister()
 

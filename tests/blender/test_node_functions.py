@@ -85,7 +85,8 @@ def test_shade_groups_match_numpy(empty_scene, tables, kind):
     vals = shade_inputs(kind)
     for features in (Features("kulla_conty", "wrapped", sheen=True, cloth=True), Features("turquin", "cod"),
                      Features("none", "cod", sheen=True, cloth=True), Features("fdez_aguera", "cod_wrapped"),
-                     Features("turquin", "oren_nayar")):
+                     Features("turquin", "oren_nayar"), Features("turquin", "cod", sheen="zeltner"),
+                     Features("single", "lambert", sheen="disney_fitted")):
         fn = light_shading.shade_function(kind, features)
         check_function(fn, {k: np.asarray(vals[k], np.float32) for k in fn.input_sockets}, tables)
 

@@ -50,7 +50,7 @@ def test_world_helper_groups_match_numpy(empty_scene, tables):
     from rt_lookdev.core.materials import world_shading as world
 
     for fn in (world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD, world.SH_LTC_CLOTH, world.SH_LTC_SHEEN,
-               world.SH_LTC_OREN_NAYAR):
+               world.SH_LTC_OREN_NAYAR, world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED, world.SH_MOMENTS):
         _check(fn, tables)
     for model in ("single", "turquin", "fdez_aguera", "kulla_conty"):
         for form in (("irradiance", "radiance") if model == "fdez_aguera" else ("irradiance",)):
@@ -66,7 +66,8 @@ def test_shade_world_groups_match_numpy(empty_scene, tables, environment):
     tables = tables.with_tables(env.as_table())
     for features in (Features("fdez_aguera", "cod", sheen=True, cloth=True),
                      Features("kulla_conty", "wrapped"), Features("single", "lambert"),
-                     Features("turquin", "oren_nayar")):
+                     Features("turquin", "oren_nayar"),
+                     Features("turquin", "cod", sheen="zeltner"), Features("none", "lambert", sheen="disney_fitted")):
         fn = world.shade_world_function(features, env)
         _check(fn, tables)
         counts = node_emit.tree_node_counts(node_emit.ensure_function_group(fn, tables))

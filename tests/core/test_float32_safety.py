@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from rt_lookdev.core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter, rough_diffuse
+from rt_lookdev.core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter, rough_diffuse, sheen
 
 F = np.float32
 COS = np.array([-1.0, -1e-7, 0.0, 1e-7, 0.5, 1.0 - 1e-7, 1.0], dtype=F)
@@ -28,6 +28,10 @@ CASES = {
     "inverse_square_falloff": lambda: falloff.inverse_square_falloff(UNIT),
     "cone_falloff": lambda: falloff.cone_falloff(*grid(COS, UNIT * F(3.1), UNIT * F(3.1))),
     "projector_distance": lambda: falloff.projector_distance(*grid(UNIT, UNIT * F(3.1))),
+    # the sheen LTC at every direction of the grid, a and b from 0 (Cycles' dropped cells) to beyond the table's
+    "zeltner_density": lambda: sheen.zeltner_density(*grid(COS, COS, COS, UNIT, COS * F(2))),
+    "zeltner_packed_inverse": lambda: np.stack(np.broadcast_arrays(*sheen.zeltner_packed_inverse(*grid(UNIT, COS)))),
+    "zeltner_roughness": lambda: sheen.zeltner_roughness(UNIT),
 }
 CASES.update({
     "fon_single_scatter_cos": lambda: rough_diffuse.fon_single_scatter_cos(*grid(COS, COS, COS, UNIT)),

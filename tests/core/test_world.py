@@ -96,7 +96,9 @@ ALL_FEATURES = [Features(s, d, sheen, cloth, form)
                                                  ("fdez_aguera", "wrapped", True, False, "irradiance"),
                                                  ("fdez_aguera", "cod", False, True, "radiance"),
                                                  ("none", "wrapped", True, True, "irradiance"),
-                                                 ("kulla_conty", "cod", True, True, "irradiance"))]
+                                                 ("kulla_conty", "cod", True, True, "irradiance"),
+                                                 ("turquin", "cod", "zeltner", False, "irradiance"),
+                                                 ("none", "lambert", "disney_fitted", False, "irradiance"))]
 
 
 def test_white_furnace_multiscattering_is_one():
@@ -241,7 +243,7 @@ def test_world_functions_are_small():
     rng = np.random.default_rng(8)
     env = _random_env(rng)
     fns = [world.prefiltered_function(env), world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD,
-           world.SH_LTC_CLOTH, world.SH_LTC_SHEEN]
+           world.SH_LTC_CLOTH, world.SH_LTC_SHEEN, world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED, world.SH_MOMENTS]
     fns += [world.specular_function(s, form) for s in ("single", "turquin", "fdez_aguera", "kulla_conty")
             for form in ("irradiance", "radiance")]
     fns += [world.shade_world_function(f, env) for f in ALL_FEATURES]

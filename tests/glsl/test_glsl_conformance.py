@@ -129,7 +129,8 @@ def test_world_functions_compute_like_numpy(gl, tables, environment):
     vals = grids.world_inputs(size=SIZE)
     tables = tables.with_tables(environment.as_table())
     functions = [world.prefiltered_function(environment), world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD,
-                 world.SH_LTC_CLOTH, world.SH_LTC_SHEEN]
+                 world.SH_LTC_CLOTH, world.SH_LTC_SHEEN, world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED,
+                 world.SH_MOMENTS]
     functions += [world.specular_function(model, form) for model in ("single", "turquin", "fdez_aguera", "kulla_conty")
                   for form in (("irradiance", "radiance") if model == "fdez_aguera" else ("irradiance",))]
     functions += [world.shade_world_function(f, environment) for f in (

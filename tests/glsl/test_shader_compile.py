@@ -35,7 +35,9 @@ def test_every_library_function_compiles(glslang_path, dialect):
     from rt_lookdev.node_groups import library
 
     functions = list(library.all_functions()) + [world.WORLD_ROTATION, world.SH_LOBE, world.SH_LTC_COD,
-                                                 world.SH_LTC_CLOTH, world.SH_LTC_SHEEN, world.SH_LTC_OREN_NAYAR]
+                                                 world.SH_LTC_CLOTH, world.SH_LTC_SHEEN, world.SH_LTC_OREN_NAYAR,
+                                                 world.SH_LTC_ZELTNER, world.SH_LTC_DISNEY_FITTED,
+                                                 world.SH_MOMENTS]
     for fn in functions:
         module = _compile_function(fn, dialect)
         # readable output: one function per node function, named after it, with its description
@@ -51,6 +53,10 @@ MATERIALS = {
                                                               environment_ms="radiance"), ("sun", "sun", "spot"), True),
     "minimal: single + Lambert, one point, no world": (dict(specular="single", diffuse="lambert"), ("point",), False),
     "no lights, world only": (dict(specular="turquin", diffuse="cod", sheen=True), (), True),
+    "zeltner sheen, every light kind, world": (dict(specular="turquin", diffuse="cod", sheen="zeltner"),
+                                               ("quad", "disk", "point", "spot", "sun"), True),
+    "fitted disney sheen, quad and sun": (dict(specular="single", diffuse="lambert", sheen="disney_fitted"),
+                                          ("quad", "sun"), False),
 }
 #: The rough diffuse (Oren-Nayar as Cycles): every light kind and the world.
 MATERIALS["turquin + Oren-Nayar, every light kind, world"] = (dict(specular="turquin", diffuse="oren_nayar"),
