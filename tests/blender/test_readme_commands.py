@@ -43,6 +43,8 @@ RUN_BY = {
     "scripts/benchmark_wrapped_diffuse.py": "here",
     "scripts/benchmark_light_fallback.py": "here",
     "scripts/benchmark_light_culling.py": "here",
+    "scripts/validate_rough_diffuse.py": "here",
+    "scripts/measure_sheen_table.py": "here",
 }
 
 #: The commands run here: (script, arguments, files it must write under the output folder).
@@ -60,6 +62,9 @@ SMOKE = {
     "scripts/benchmark_light_fallback.py": (["--quick", "--out", "{out}"], ["light_fallback.md", "light_fallback.json"]),
     "scripts/benchmark_light_culling.py": (["--quick", "--scenes", "grid", "--out", "{out}"],
                                            ["light_culling.md", "light_culling.json"]),
+    "scripts/validate_rough_diffuse.py": (["--resolution", "24", "--samples", "8", "--out", "{out}"],
+                                          ["rough_diffuse_furnace.json"]),
+    "scripts/measure_sheen_table.py": (["--lut-dir", "{out}"], ["zeltner_sheen.exr", "zeltner_sheen_sh1.exr"]),
 }
 
 
