@@ -149,11 +149,14 @@ def write_scene(folder, features, world, count, resolution, lut_dir):
             spec = catalog.TABLES[table]
             tables[table] = spec.filename
             table_files[spec.filename] = Path(lut_dir) / spec.filename
-    inputs = {"Base Color": [0.8, 0.5, 0.3], "Metallic": 0.3, "Roughness": 0.4, "IOR": 1.5, "Specular IOR Level": 0.5,
-              "Specular Tint": [1.0, 1.0, 1.0], "Wrap": 0.3, "Sheen Weight": 0.5, "Sheen Tint": [1.0, 1.0, 1.0],
-              "Cloth Weight": 0.3, "Cloth Color": [0.9, 0.7, 0.8], "Emission Color": [1.0, 1.0, 1.0],
-              "Emission Strength": 0.0, "Normal": [0.0, 0.0, 0.0]}
-    inputs["Diffuse Roughness"] = 0.6
+    # every input at its socket default (inputs added later are covered), then the benchmark's values
+    inputs = {name: (float(s.default) if s.kind == "float" else [float(x) for x in s.default[:3]])
+              for name, s in rt_lit.RT_LIT_INPUTS.items()}
+    inputs.update({"Base Color": [0.8, 0.5, 0.3], "Metallic": 0.3, "Roughness": 0.4, "IOR": 1.5,
+                   "Specular IOR Level": 0.5, "Specular Tint": [1.0, 1.0, 1.0], "Wrap": 0.3, "Sheen Weight": 0.5,
+                   "Sheen Tint": [1.0, 1.0, 1.0], "Cloth Weight": 0.3, "Cloth Color": [0.9, 0.7, 0.8],
+                   "Emission Color": [1.0, 1.0, 1.0], "Emission Strength": 0.0, "Normal": [0.0, 0.0, 0.0],
+                   "Diffuse Roughness": 0.6, "Sheen Roughness": 0.5})
     mat = scene_io.SceneMaterial("benchmark", features.as_dict(), inputs)
     positions, normals = uv_sphere()
     obj = scene_io.SceneObject("sphere", "benchmark", "0", len(positions) // 3)
