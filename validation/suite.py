@@ -89,6 +89,7 @@ def _pool(entries):
     noise = [e["noise"] for e in entries if e.get("noise") is not None]
     if noise:
         out["noise_median"] = float(np.median(np.concatenate(noise)))
+        out["noise_p90"] = float(np.percentile(np.concatenate(noise), 90))
     wide = [e["rel_wide"] for e in entries if e.get("rel_wide") is not None]
     if wide:
         w = np.concatenate(wide)
@@ -340,6 +341,74 @@ def run_furnace(args, out_dir, log=print):
 
 # --- driver ------------------------------------------------------------------------------------
 
+#: Regression gates of the (a) vs (c) error, pooled per technique and light kind: (median, p90) at most.  Each is
+#: the full suite's measurement (``gates_markdown`` writes them beside it: docs/benchmarks/validation.md) times
+#: GATE_MARGIN, rounded up to two significant digits; a technique is only as good as measured, and a change that
+#: makes one worse by half fails.  Against Cycles a figure within GATE_NOISE_FACTOR x the reference's own noise also
+#: passes (no error below it can be measured: the CI's quick run renders 8x fewer samples).  Lambert and GGX keep
+#: their own gates (``DEFAULTS``).
+GATE_MARGIN = 1.5
+GATE_NOISE_FACTOR = 3.0
+GATES = {}
+
+
+def gate_checks(pooled, gates=None):
+    """One check per pooled (technique, light) that ``gates`` (default ``GATES``) holds."""
+    gates = GATES if gates is None else gates
+    checks = []
+    for g in pooled:
+        limit = gates.get((g["technique"], g["light"]))
+        if limit is None or not g.get("values"):
+            continue
+        median_max, p90_max = limit
+        noise_m = GATE_NOISE_FACTOR * g.get("noise_median", 0.0)
+        noise_p = GATE_NOISE_FACTOR * g.get("noise_p90", 0.0)
+        ok = g["median"] <= max(median_max, noise_m) and g["p90"] <= max(p90_max, noise_p)
+        checks.append({"name": f"{g['technique']} under {g['light']} lights vs {g['truth']}: median / p90",
+                       "measured": f"{g['median']:.3%} / {g['p90']:.3%}"
+                                   + (f" (reference noise {g['noise_median']:.3%} / {g['noise_p90']:.3%})"
+                                      if "noise_median" in g else ""),
+                       "threshold": f"{median_max:.3%} / {p90_max:.3%}"
+                                    + (f" or {GATE_NOISE_FACTOR:g}x the noise" if "noise_median" in g else ""),
+                       "ok": bool(ok)})
+    return checks
+
+
+def _round_up(x, digits=2):
+    if x <= 0:
+        return 0.0
+    e = np.floor(np.log10(x)) - (digits - 1)
+    return float(np.ceil(x / 10 ** e) * 10 ** e)
+
+
+def measured_gates(pooled, margin=GATE_MARGIN):
+    """``GATES`` from a full run's pooled figures: margin x (median, p90), rounded up (``gates_markdown``)."""
+    return {(g["technique"], g["light"]): (_round_up(margin * g["median"]), _round_up(margin * g["p90"]))
+            for g in pooled if g.get("values") and g["technique"] not in ("lambert", "ggx")}
+
+
+def gates_markdown(result):
+    """The pooled (a) vs (c) figures of a run with the gates they imply: docs/benchmarks/validation.md."""
+    gates = measured_gates(result["pooled"])
+    L = ["# Validation suite: pooled error per technique and light kind", "",
+         f"`python scripts/validate.py` (validation/suite.py), Blender {result['settings']['blender']}, "
+         f"{result['settings']['samples']} samples x {len(result['settings']['seeds'])} seeds per Cycles reference, "
+         f"{result['timings_s']['total']:.0f} s. Relative error of the node render (a) against the ground truth (c) "
+         f"over the values above {result['settings']['floor']:g} x each sphere's maximum, pooled per technique and "
+         "light kind; the reference's own noise beside it; the gate that `validation/suite.py` `GATES` holds "
+         f"({GATE_MARGIN:g} x the measurement, rounded up; within {GATE_NOISE_FACTOR:g}x the noise also passes).", "",
+         "| technique | light | truth | values | median | p90 | reference noise (median / p90) | gate (median / p90) |",
+         "|---|---|---|---|---|---|---|---|"]
+    for g in result["pooled"]:
+        if not g.get("values"):
+            continue
+        noise = (f"{g['noise_median']:.3%} / {g['noise_p90']:.3%}" if "noise_median" in g else "-")
+        gate = gates.get((g["technique"], g["light"]))
+        L.append(f"| {g['technique']} | {g['light']} | {g['truth']} | {g['values']} | {g['median']:.3%} | "
+                 f"{g['p90']:.3%} | {noise} | " + (f"{gate[0]:.3%} / {gate[1]:.3%}" if gate else "own gate") + " |")
+    return "\n".join(L) + "\n"
+
+
 def _checks(args, cases, pooled, furnace):
     checks = []
     worst = max(cases, key=lambda c: c["ab"]["max_rel"]) if cases else None
@@ -369,6 +438,7 @@ def _checks(args, cases, pooled, furnace):
                        "measured": f"{g['median']:.2%} / {g['p90']:.2%}",
                        "threshold": f"{args.ggx_quad_median:.0%} / {args.ggx_quad_p90:.0%}",
                        "ok": g["median"] <= args.ggx_quad_median and g["p90"] <= args.ggx_quad_p90})
+    checks += gate_checks(pooled)
     if furnace:
         checks.append({"name": "furnace: Cycles Multiscatter GGX (F = 1) mean per roughness",
                        "measured": ", ".join(f"{v['mean']:.4f}" for v in furnace["multi_ggx"].values()),
