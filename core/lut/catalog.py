@@ -95,14 +95,24 @@ LTC_LOBES = {
     "ltc_cloth": ("cloth", "Ashikhmin velvet + Neubelt-Pettineo visibility (colour 1)"),
 }
 
+#: Lobes whose LTC carries a band (docs/area_lights.md, "The band"; issue 15): a second LTC, the fitted Minv with
+#: its third column scaled by ``squash`` (``core.ltc.matrix.squash_packed``), mixed in with a weight in [0,
+#: ``max_weight``] fitted per cell jointly with Minv and stored in channel B of the ``_mag`` table.  Measured:
+#: docs/benchmarks/ltc_suite_like.md.
+LTC_BANDS = {"ltc_ggx": {"squash": 3.0, "max_weight": 0.9}}
+
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
-    GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=dict(LTC_FIT, lobe=_lobe),
+    _params = dict(LTC_FIT, lobe=_lobe, **({"band": LTC_BANDS[_prefix]} if _prefix in LTC_BANDS else {}))
+    GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=_params,
                                 sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_prefix, ()))
 
 LTC_INV_CHANNELS = ("R = c0 = Minv_xx, G = c1 = Minv_zx, B = c2 = Minv_xz, A = c3 = Minv_zz "
                     "(Minv normalised so that Minv_yy = 1)")
 LTC_MAG_CHANNELS = ("R = magnitude = int f cos, G = fresnel = int f cos (1 - v.h)^5, B = 0, "
                     "A = horizon-clipped sphere ratio on its own axes (u = z/2 + 1/2, v = |F|)")
+#: The same for a lobe with a band (``LTC_BANDS``): B is the band's weight.
+LTC_MAG_BAND_CHANNELS = LTC_MAG_CHANNELS.replace(
+    "B = 0", "B = band weight w (integral = (1 - w) I(Minv) + w I(Minv diag(1, 1, k)), k = the band's squash)")
 
 TABLES = {
     spec.name: spec
@@ -135,7 +145,8 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
     TABLES[_prefix + "_mag"] = TableSpec(
         name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
-        channels=LTC_MAG_CHANNELS, description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
+        channels=LTC_MAG_BAND_CHANNELS if _prefix in LTC_BANDS else LTC_MAG_CHANNELS,
+        description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
 
 _PACKAGE_ROOT = Path(__file__).resolve().parents[2]
