@@ -16,6 +16,11 @@ which can only lower the error; all roughness values of a view row are solved to
 Nelder-Mead; each row starts from the better of the previous row's matrix and that matrix
 rotated with the average direction; the first row (normal incidence) is isotropic,
 Minv = diag(1, 1, c3), found by a grid search and refined.
+
+With a ``Band`` (the GGX table, ``catalog.LTC_BANDS``; docs/area_lights.md, "The band") the fitted density
+is the mixture (1 - w) D(Minv) + w D(Minv diag(1, 1, k)) and each cell fits five parameters, Minv's four
+and w, with the same objective; the band's own directions join the sample set.  Without a band the fit
+is the same, to the bit, as before the band existed.
 """
 from __future__ import annotations
 

@@ -110,9 +110,16 @@ LTC_INV_CHANNELS = ("R = c0 = Minv_xx, G = c1 = Minv_zx, B = c2 = Minv_xz, A = c
                     "(Minv normalised so that Minv_yy = 1)")
 LTC_MAG_CHANNELS = ("R = magnitude = int f cos, G = fresnel = int f cos (1 - v.h)^5, B = 0, "
                     "A = horizon-clipped sphere ratio on its own axes (u = z/2 + 1/2, v = |F|)")
-#: The same for a lobe with a band (``LTC_BANDS``): B is the band's weight.
-LTC_MAG_BAND_CHANNELS = LTC_MAG_CHANNELS.replace(
-    "B = 0", "B = band weight w (integral = (1 - w) I(Minv) + w I(Minv diag(1, 1, k)), k = the band's squash)")
+
+
+def ltc_mag_channels(prefix):
+    """The channels of ``prefix``'s ``_mag`` table: ``LTC_MAG_CHANNELS``, with B the band's weight for a lobe that
+    has one (``LTC_BANDS``)."""
+    band = LTC_BANDS.get(prefix)
+    if band is None:
+        return LTC_MAG_CHANNELS
+    return LTC_MAG_CHANNELS.replace("B = 0", "B = band weight w (integral = (1 - w) I(Minv) + w I(Minv diag(1, 1, "
+                                              f"{band['squash']:g})))")
 
 TABLES = {
     spec.name: spec
@@ -145,7 +152,7 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
     TABLES[_prefix + "_mag"] = TableSpec(
         name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
-        channels=LTC_MAG_BAND_CHANNELS if _prefix in LTC_BANDS else LTC_MAG_CHANNELS,
+        channels=ltc_mag_channels(_prefix),
         description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
 
