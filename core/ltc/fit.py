@@ -19,11 +19,12 @@ Minv = diag(1, 1, c3), found by a grid search and refined.
 
 With a ``Band`` (the GGX table, ``catalog.LTC_BANDS``; docs/area_lights.md, "The band") the fitted density
 is the mixture (1 - w) D(Minv) + w D(Minv diag(1, 1, k)) and each cell fits five parameters, Minv's four
-and w, with the same objective; the band's own directions join the sample set.  Without a band the fit
-is the same, to the bit, as before the band existed.
+and w, with the same objective; the band's own directions join the sample set.  Columns below the band's
+``min_roughness`` keep the fit without a band, which is the same, to the bit, as before the band existed.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,10 +42,12 @@ class Band:
     """A second LTC mixed into the fitted one (docs/area_lights.md, "The band"): density
     (1 - w) D(Minv) + w D(Minv diag(1, 1, squash)) (``matrix.squash_packed``: the fitted lobe pressed towards
     the horizon), w fitted per cell jointly with Minv.  ``max_weight``: the weight's upper bound (the
-    optimiser's raw parameter is clipped to [0, max_weight]); ``samples``: directions drawn from the band per
-    cell for the objective; ``weight_step``: the weight's initial simplex step."""
+    optimiser's raw parameter is clipped to [0, max_weight]); ``min_roughness``: columns of lower roughness
+    keep the fit without a band (w = 0; where the band does not pay, measured); ``samples``: directions drawn
+    from the band per cell for the objective; ``weight_step``: the weight's initial simplex step."""
     squash: float
     max_weight: float = 0.9
+    min_roughness: float = 0.0
     samples: int = 128
     weight_step: float = 0.05
 
@@ -223,6 +226,20 @@ def fit_table(lobe_name, size=64, n_moments=1 << 14, n_lobe=384, n_ltc=384, n_sp
     ``band`` (a ``Band``) its ``weight`` per cell, fitted jointly with the matrix.
     Axes: a -> r = a/(size-1); t -> v = t/(size-1), mu = max(1 - v^2, FIT_MU_MIN).
     """
+    if band is not None and band.min_roughness > 0.0:
+        # two fits, columns merged: below min_roughness the fit without a band (the same numbers as a table fitted
+        # without one), from it the fit with the band (every column's Nelder-Mead is independent of the others')
+        kw = dict(size=size, n_moments=n_moments, n_lobe=n_lobe, n_ltc=n_ltc, n_sphere=n_sphere, exponent=exponent,
+                  max_iter=max_iter)
+        half = (lambda first: (lambda done, total: progress(done + (0 if first else total), 2 * total))
+                if progress is not None else (lambda first: None))
+        plain = fit_table(lobe_name, progress=half(True), **kw)
+        banded = fit_table(lobe_name, band=dataclasses.replace(band, min_roughness=0.0), progress=half(False), **kw)
+        keep = np.arange(size) / (size - 1) < band.min_roughness
+        for key in ("packed", "objective", "iterations"):
+            banded[key][:, keep] = plain[key][:, keep]
+        banded["weight"][:, keep] = 0.0
+        return banded
     lobe = LOBES[lobe_name]
     nodes = np.arange(size, dtype=np.float64) / (size - 1)
     r = nodes

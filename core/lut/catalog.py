@@ -97,9 +97,9 @@ LTC_LOBES = {
 
 #: Lobes whose LTC carries a band (docs/area_lights.md, "The band"; issue 15): a second LTC, the fitted Minv with
 #: its third column scaled by ``squash`` (``core.ltc.matrix.squash_packed``), mixed in with a weight in [0,
-#: ``max_weight``] fitted per cell jointly with Minv and stored in channel B of the ``_mag`` table.  Measured:
-#: docs/benchmarks/ltc_suite_like.md.
-LTC_BANDS = {"ltc_ggx": {"squash": 3.0, "max_weight": 0.9}}
+#: ``max_weight``] fitted per cell jointly with Minv and stored in channel B of the ``_mag`` table; columns below
+#: ``min_roughness`` keep the fit without a band (w = 0).  Measured: docs/benchmarks/ltc_suite_like.md.
+LTC_BANDS = {"ltc_ggx": {"squash": 3.0, "max_weight": 0.9, "min_roughness": 0.65}}
 
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
     _params = dict(LTC_FIT, lobe=_lobe, **({"band": LTC_BANDS[_prefix]} if _prefix in LTC_BANDS else {}))
