@@ -78,11 +78,11 @@ def compare(before_dir, after_dir, techniques=GGX_TECHNIQUES, floor=0.1, seed=0)
     return {"floor": floor, "rows": rows, "bands": band_rows}
 
 
-def markdown(res):
+def markdown(res, intro=()):
     def cells(r):
         return " | ".join(f"{100 * r['before'][k]:.2f}% / **{100 * r['after'][k]:.2f}%**" for k in ("median", "p90", "rms"))
 
-    lines = [f"Relative error over values above {res['floor']:g} x the sphere's maximum; before / after.", "",
+    lines = list(intro) + [f"Relative error over values above {res['floor']:g} x the sphere's maximum; before / after.", "",
              "| light | roughness | values | median | p90 | RMS |", "|---|---|---|---|---|---|"]
     lines += [f"| {r['light']} | {r['band']} | {r['before']['values']} | {cells(r)} |" for r in res["bands"]]
     lines += ["", "| technique | light | r | values | median | p90 | RMS |", "|---|---|---|---|---|---|---|"]
@@ -99,12 +99,13 @@ def parse_args(argv):
     p.add_argument("--floor", type=float, default=0.1)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", type=Path, default=None, help="write the markdown (and a .json beside it) here")
+    p.add_argument("--intro", default=None, help="a file whose text opens the markdown (what the two runs were)")
     return p.parse_args(argv)
 
 
 def run(args, log=print):
     res = compare(args.before, args.after, tuple(args.techniques), args.floor, args.seed)
-    text = markdown(res)
+    text = markdown(res, [Path(args.intro).read_text().rstrip("\n"), ""] if args.intro else ())
     if args.out:
         args.out.write_text(text)
         args.out.with_suffix(".json").write_text(json.dumps(res, indent=1))
