@@ -58,14 +58,15 @@ def compute_ltc_tables(prefix, params, progress=None):
     from .ltc import fit, sphere_table
 
     n_lobe, n_ltc, n_sphere = params["fit_samples"]
+    band = fit.Band(**params["band"]) if "band" in params else None
     result = fit.fit_table(params["lobe"], size=params["size"], n_moments=params["moment_samples"],
                            n_lobe=n_lobe, n_ltc=n_ltc, n_sphere=n_sphere, exponent=params["exponent"],
-                           max_iter=params["max_iter"], progress=progress)
+                           max_iter=params["max_iter"], progress=progress, band=band)
     sphere = sphere_table.sphere_horizon_table(params["size"])
-    zeros = np.zeros_like(result["magnitude"])
+    weight = result.get("weight", np.zeros_like(result["magnitude"]))     # channel B: the band's weight, or 0
     return {
         prefix + "_inv": result["packed"].astype(np.float32),
-        prefix + "_mag": np.stack([result["magnitude"], result["fresnel"], zeros, sphere], axis=-1).astype(np.float32),
+        prefix + "_mag": np.stack([result["magnitude"], result["fresnel"], weight, sphere], axis=-1).astype(np.float32),
     }
 
 

@@ -54,11 +54,14 @@ def table_nodes():
     return nodes, mu
 
 
-def tv_map(lobe_name, packed, magnitude, n):
-    """TV distance of every table cell (t, a)."""
+def tv_map(lobe_name, packed, magnitude, n, band=None, weight=None):
+    """TV distance of every table cell (t, a); with a band (``catalog.LTC_BANDS``) and its weight per cell, of
+    the mixture the shading uses."""
     lobe = lobes.LOBES[lobe_name]
     nodes, mu = table_nodes()
-    return np.stack([fit.tv_distance(lobe, mu[t], nodes, magnitude[t], packed[t], n=n) for t in range(nodes.size)])
+    fit_band = fit.Band(**band) if band is not None else None
+    return np.stack([fit.tv_distance(lobe, mu[t], nodes, magnitude[t], packed[t], n=n, band=fit_band,
+                                     weight=None if weight is None else weight[t]) for t in range(nodes.size)])
 
 
 def magnitude_check(ltc_mag, published_mag, n_ref):
@@ -86,7 +89,8 @@ def fit_quality(tables, published, n_tv, out_dir, prefixes=None):
             continue
         packed = tables[prefix + "_inv"].astype(np.float64)
         mag = tables[prefix + "_mag"][..., 0].astype(np.float64)
-        tv = tv_map(lobe_name, packed, mag, n_tv)
+        band = catalog.LTC_BANDS.get(prefix)
+        tv = tv_map(lobe_name, packed, mag, n_tv, band, tables[prefix + "_mag"][..., 2] if band else None)
         entry = {"tv_mean": float(tv.mean()), "tv_p90": float(np.quantile(tv, 0.9)), "tv_max": float(tv.max())}
         _png.heatmap(out_dir / f"ltc_tv_{lobe_name}.png", tv, vmax=0.3)
         if prefix == "ltc_ggx" and published is not None:
@@ -173,15 +177,20 @@ def _truth(kind, f_cos, v, geom):
     return q.value, q.error
 
 
-def _ltc_estimate(kind, inv_table, mag_table, sphere, r, mu, geom, use_fresnel=False, scale=1.0):
+def _ltc_estimate(kind, inv_table, mag_table, sphere, r, mu, geom, use_fresnel=False, scale=1.0, band=None):
     u, w = lookup.ltc_lut_uv(np.array(mu), np.array(r))
     packed = semantics.sample_bilinear(inv_table, u, w)
     mag = semantics.sample_bilinear(mag_table, u, w)
     c = tuple(packed[..., i] for i in range(4))          # the shader path: packed Minv, traceable code
-    if kind == "quad":
-        value = polygon.ltc_polygon_integral_packed(c, list(geom), False, sphere)
-    else:
-        value = disk.ltc_disk_integral_packed(c, *geom, False, sphere)
+
+    def integral(c):
+        if kind == "quad":
+            return polygon.ltc_polygon_integral_packed(c, list(geom), False, sphere)
+        return disk.ltc_disk_integral_packed(c, *geom, False, sphere)
+
+    value = integral(c)
+    if band is not None:                                 # the table's band (catalog.LTC_BANDS), weight in B
+        value = shading.mix_band(value, integral(matrix.squash_packed(c, band["squash"])), mag[2])
     return float(value) * float(mag[1] if use_fresnel else mag[0]) * scale
 
 
@@ -225,7 +234,7 @@ def end_to_end(tables, published, n_quads, n_disks, seed=2019, prefixes=None):
                 rows["albedo"].append(albedo)
                 rows["theta"].append(theta)
                 rows["ours"].append(_ltc_estimate(kind, tables[prefix + "_inv"], tables[prefix + "_mag"], sphere,
-                                                  r, mu, geom))
+                                                  r, mu, geom, band=catalog.LTC_BANDS.get(prefix)))
                 if prefix == "ltc_ggx" and published is not None:
                     rows["published"].append(_ltc_estimate(kind, published[0], published[1], published[1][..., 3],
                                                            r, mu, geom))

@@ -358,6 +358,7 @@ def rough_diffuse_cases(cases):
                             description=f"{case.lights[0].describe()}: Oren-Nayar (top) and CoD (bottom), "
                                         "sigma = 0.3, 0.6, 1, vs Cycles' rough Diffuse BSDF",
                             tags=dict(case.tags, rough_diffuse=True)))
+    return out
 
 
 #: The sheen row (issue 17): Zeltner at three sheen roughnesses and under Principled's layering (Cycles truth),

@@ -9,6 +9,8 @@ sphere table on its own; in the ``rtl`` layout under the catalog's names (core/l
 inverse matrix normalised by its middle element; ``ltc_2`` = magnitude, Fresnel, 0, sphere table),
 the same axes (x = roughness r, y = sqrt(1 - cos theta_v), texel centres) and the same memory order (flat
 index a + 64 t, row t = 0 first), so an engine that reads the published tables swaps ours in unchanged.
+One addition: the GGX pair's ``ltc_2`` carries the band's weight in B (ltc_code leaves it 0; docs/luts.md,
+``ltc_ggx_mag``): the lobe is (1 - B) LTC(Minv) + B LTC(Minv diag(1, 1, k)), k in the table's channel text.
 
 Formats (one file per table and precision, unless noted): ``exr`` (OpenEXR scanline, ZIP, FLOAT or HALF
 channels), ``ktx2`` (KTX 2.0, RGBA16F / RGBA32F; core/export/containers.py), ``dds`` (DDS with the DX10

@@ -73,3 +73,12 @@ def density_packed(c, w):
     length2 = x * x + y * y + z * z
     det = np.abs(c0 * c3 - c1 * c2)[..., None]
     return np.maximum(z, 0.0) / np.pi * det / np.maximum(length2 * length2, 1e-300)
+
+
+# The GGX table's band (this project's, issue 15; docs/area_lights.md, "The band"): the fitted LTC with its
+# third column scaled by k, Minv diag(1, 1, k): the density at w is the fitted one's at (x, y, k z), its lobe
+# pressed towards the horizon (k > 1) with the same azimuths.  Minv_yy stays 1 (the packing holds).
+def squash_packed(c, k):
+    """Packed entries of Minv diag(1, 1, k) for packed entries c = (c0, c1, c2, c3) (arrays or Exprs)."""
+    c0, c1, c2, c3 = c
+    return c0, c1, c2 * k, c3 * k

@@ -23,7 +23,8 @@ from .. import diffuse, multiscatter, sheen
 from .. import shading_ops as op
 from ..ir.functions import NodeFunction
 from ..ir.interface import factor, vector
-from . import disk, polygon
+from ..lut import catalog
+from . import disk, matrix, polygon
 
 #: The talk's Disney sheen uses the CoD diffuse tables at this roughness (smoothness 0.5).
 SHEEN_TABLE_ROUGHNESS = 0.5
@@ -88,11 +89,32 @@ class DiskLight:
 
 
 def lobe_integral(tables, prefix, light, p, n, v, roughness):
-    """(LTC integral, magnitude, fresnel) of one table's lobe at this shading point."""
+    """(LTC integral, magnitude, fresnel) of one table's lobe at this shading point (with its band, for a lobe
+    that has one: ``band_integral``)."""
     mu = op.saturate(op.dot(n, v))
-    packed, magnitude, fresnel = tables.ltc(prefix, mu, roughness)
-    value = light.integral(tables, packed, polygon.local_frame(n, v), p)
-    return value, magnitude, fresnel
+    frame = polygon.local_frame(n, v)
+    band = catalog.LTC_BANDS.get(prefix)
+    if band is None:
+        packed, magnitude, fresnel = tables.ltc(prefix, mu, roughness)
+        return light.integral(tables, packed, frame, p), magnitude, fresnel
+    packed, magnitude, fresnel, weight = tables.ltc(prefix, mu, roughness, band_weight=True)
+    return band_integral(tables, light, packed, weight, band["squash"], frame, p), magnitude, fresnel
+
+
+# The band (this project's, issue 15; docs/area_lights.md, "The band"): the lobe is the mixture
+# (1 - w) D(Minv) + w D(Minv diag(1, 1, k)) of the fitted LTC and the same LTC pressed towards the horizon
+# (``matrix.squash_packed``), so its integral is the same mixture of the two LTC integrals (Heitz et al. 2016,
+# eq. 11, for each), written main + w (band - main); w is bounded by [0, 1] (saturate) as the fit bounds it.
+def mix_band(main, band, weight):
+    """The mixture's integral from the two LTC integrals and the band's weight."""
+    return main + op.saturate(weight) * (band - main)
+
+
+def band_integral(tables, light, packed, weight, squash, frame, p):
+    """Integral of the LTC with packed entries ``packed`` mixed with its band (squash factor ``squash``) by
+    ``weight``, over the light, in the shading frame ``frame``."""
+    return mix_band(light.integral(tables, packed, frame, p),
+                    light.integral(tables, matrix.squash_packed(packed, squash), frame, p), weight)
 
 
 # Heitz et al. 2016 with Hill 2016's Fresnel split: int f cos F = F0 (mag - fres) + F90 fres.

@@ -103,8 +103,15 @@ LTC_LOBES = {
     "ltc_disney_sheen": ("disney_sheen", "Disney sheen (1 - l.h)^5 (colour 1; no roughness: every column alike)"),
 }
 
+#: Lobes whose LTC carries a band (docs/area_lights.md, "The band"; issue 15): a second LTC, the fitted Minv with
+#: its third column scaled by ``squash`` (``core.ltc.matrix.squash_packed``), mixed in with a weight in [0,
+#: ``max_weight``] fitted per cell jointly with Minv and stored in channel B of the ``_mag`` table; columns below
+#: ``min_roughness`` keep the fit without a band (w = 0).  Measured: docs/benchmarks/ltc_suite_like.md.
+LTC_BANDS = {"ltc_ggx": {"squash": 3.0, "max_weight": 0.9, "min_roughness": 0.65}}
+
 for _prefix, (_lobe, _text) in LTC_LOBES.items():
-    GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=dict(LTC_FIT, lobe=_lobe),
+    _params = dict(LTC_FIT, lobe=_lobe, **({"band": LTC_BANDS[_prefix]} if _prefix in LTC_BANDS else {}))
+    GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=_params,
                                 sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_prefix, ()))
 
 #: Cycles' sheen (Zeltner, Burley & Chiang 2022): the LTC (a, b) and albedo of each (mu, r), measured from
@@ -125,6 +132,16 @@ LTC_INV_CHANNELS = ("R = c0 = Minv_xx, G = c1 = Minv_zx, B = c2 = Minv_xz, A = c
                     "(Minv normalised so that Minv_yy = 1)")
 LTC_MAG_CHANNELS = ("R = magnitude = int f cos, G = fresnel = int f cos (1 - v.h)^5, B = 0, "
                     "A = horizon-clipped sphere ratio on its own axes (u = z/2 + 1/2, v = |F|)")
+
+
+def ltc_mag_channels(prefix):
+    """The channels of ``prefix``'s ``_mag`` table: ``LTC_MAG_CHANNELS``, with B the band's weight for a lobe that
+    has one (``LTC_BANDS``)."""
+    band = LTC_BANDS.get(prefix)
+    if band is None:
+        return LTC_MAG_CHANNELS
+    return LTC_MAG_CHANNELS.replace("B = 0", "B = band weight w (integral = (1 - w) I(Minv) + w I(Minv diag(1, 1, "
+                                              f"{band['squash']:g})))")
 
 TABLES = {
     spec.name: spec
@@ -173,7 +190,8 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
     TABLES[_prefix + "_mag"] = TableSpec(
         name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
-        channels=LTC_MAG_CHANNELS, description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
+        channels=ltc_mag_channels(_prefix),
+        description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
 
 #: The rough-diffuse table's u axis is the diffuse roughness (Principled "Diffuse Roughness"), not the GGX one.

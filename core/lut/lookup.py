@@ -126,17 +126,19 @@ class LutSet(Mapping):
         return op.lut_sample(table, u, v, 0), op.lut_sample(table, u, v, 1)
 
     # -- LTC (Heitz et al. 2016; Hill 2016) --------------------------------------------------------
-    def ltc(self, prefix, mu, roughness):
+    def ltc(self, prefix, mu, roughness, band_weight=False):
         """((c0, c1, c2, c3), magnitude, fresnel) of the LTC tables ``prefix`` at (mu, r): the packed
-        Minv entries (``core.ltc.matrix``) and the lobe's magnitude and Fresnel channels."""
+        Minv entries (``core.ltc.matrix``) and the lobe's magnitude and Fresnel channels; with
+        ``band_weight`` a fourth value, the band's weight (channel B of the ``_mag`` table; 0 for a lobe
+        without a band, ``catalog.LTC_BANDS``)."""
         u, v = ltc_lut_uv(mu, roughness)
         inv, mag = self[prefix + "_inv"], self[prefix + "_mag"]
         if not is_expr(u, v):                   # numpy: one bilinear read per table
             packed = sample_bilinear(inv.require_data(), u, v)
             m = sample_bilinear(mag.require_data(), u, v)
-            return tuple(packed[..., i] for i in range(4)), m[..., 0], m[..., 1]
-        return (tuple(op.lut_sample(inv, u, v, i) for i in range(4)),
-                op.lut_sample(mag, u, v, 0), op.lut_sample(mag, u, v, 1))
+            return (tuple(packed[..., i] for i in range(4)), m[..., 0], m[..., 1]) + ((m[..., 2],) if band_weight else ())
+        return ((tuple(op.lut_sample(inv, u, v, i) for i in range(4)), op.lut_sample(mag, u, v, 0),
+                 op.lut_sample(mag, u, v, 1)) + ((op.lut_sample(mag, u, v, 2),) if band_weight else ()))
 
     # -- Zeltner 2022 sheen, as Cycles shades it (core/sheen.py) ------------------------------------
     def zeltner_sheen(self, mu, roughness):

@@ -169,12 +169,15 @@ def test_ltc_code_layout_matches_the_published_table(export_ltc_code):
         pytest.skip("the published table (../shared/anchors) is not beside this checkout")
     ours = read_ltc_code_dds(export_ltc_code.folder / "ltc_1_f32.dds")
     inner = (slice(4, 60), slice(4, 60))                 # away from r = 0 (alpha floors differ) and grazing
-    # two fits of the same lobe: c0 and c2 agree closely, c1 and c3 less (measured medians 0.005, 0.049,
-    # 0.012, 0.024), but a wrong layout is an order of magnitude further off
+    # two fits of the same lobe (ours for r >= 0.65 since issue 15 the LTC of a mixture with its band, docs/luts.md):
+    # c0 and c2 agree closely, c1 and c3 less (measured medians 0.005, 0.051, 0.013, 0.025); a wrong layout is an
+    # order of magnitude further off in c0 (view axis flipped 0.34, transposed 0.40) and over all channels (c1 and
+    # c2 swapped 0.145 against 0.017; the flipped table, 0.086, is only 5x off over all channels)
+    per_channel = lambda t: np.median(np.abs(t[inner] - ltc1[inner]), axis=(0, 1))
     near = np.median(np.abs(ours[inner] - ltc1[inner]))
-    assert near < 0.03 and np.median(np.abs(ours[inner][..., 0] - ltc1[inner][..., 0])) < 0.01
-    assert np.median(np.abs(ours.transpose(1, 0, 2)[inner] - ltc1[inner])) > 5 * near
-    assert np.median(np.abs(ours[::-1][inner] - ltc1[inner])) > 5 * near
+    assert near < 0.03 and per_channel(ours)[0] < 0.01
+    assert per_channel(ours.transpose(1, 0, 2))[0] > 20 * per_channel(ours)[0]
+    assert per_channel(ours[::-1])[0] > 20 * per_channel(ours)[0]
     assert np.median(np.abs(ours[inner][..., [0, 2, 1, 3]] - ltc1[inner])) > 5 * near
 
 

@@ -1,0 +1,18 @@
+"""The GGX LTC's error against brute force on a suite-like set, per roughness and light kind, this checkout's
+tables against those of an earlier revision.
+
+    python scripts/benchmark_ltc_suite_like.py [--out docs/benchmarks] [--before REV] [--lut-dir DIR]
+
+Entry point of ``rt_lookdev.validation.ltc_suite_like``; ``--help`` lists the options."""
+import sys
+
+from rt_lookdev.validation import ltc_suite_like
+
+
+def main(argv):
+    ltc_suite_like.run(ltc_suite_like.parse_args(argv))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
