@@ -3,7 +3,8 @@
 A *family* is one technique (or combination) isolated by the material's switches and inputs
 (``FAMILIES``): GGX alone on a white metal, each multiple-scattering model, each diffuse model on a
 dielectric, cloth, sheen, everything on at once, and the World term in a white furnace.  Every family is
-tried under each light kind (quad, disk, point, spot, sun) at points drawn by ``scene_inputs``: shading
+tried under each light kind (quad, disk, point, spot, sun, and the light controls' quad+cone+range,
+disk+cone+range, quad_spot+range) at points drawn by ``scene_inputs``: shading
 normals unnormalised, zero or denormal; views grazing and back-facing; roughness exactly 0 and 1 and
 log-spread near 0; lights at 1e-6 to 1e6 m, 1e-6 to 1e6 m wide, touching the point, in its tangent
 plane, behind it, facing away, degenerate (zero size, zero or negative scale), zero power.
@@ -717,7 +718,7 @@ def markdown(result):
              "Written by `python scripts/robustness_sweep.py` (validation/robustness.py; method in "
              "docs/robustness.md).  Per technique family: the RT Lit material isolated to that technique, at "
              f"{result['points_per_family_and_kind']:,} scene-like and adversarial points per light kind "
-             f"(quad, disk, point, spot, sun; seed {result['seed']}); the image backends evaluate "
+             f"({', '.join(LIGHT_KINDS)}; seed {result['seed']}); the image backends evaluate "
              + ("the same points" if result["image_points"] is None else
                 f"the first {result['image_points']:,} of them per kind") +
              " as input images.  Cycles writes NaN and Inf pixels as 0, so each Cycles case is rendered twice: "
