@@ -170,7 +170,10 @@ def markdown(r):
              "material's outputs fed by an Emission node (the RT Lit groups stay in the file): the scene's cost "
              "without RT Lit's shading.", "",
              f"Nodes {r['node_ratio_median']:.2f}x fewer (median material; {r['node_ratio_total']:.2f}x in total), render "
-             f"{r['speedup']:.2f}x faster. Same values: the two renders differ by a median {v['median_rel']:.1e} and at "
+             f"{r['speedup']:.2f}x faster. Values: the two renders differ by a median {v['median_rel']:.1e} and at "
              f"most {v['max_rel']:.1e} relative ({v['count']} values > 1e-3; 0 is bit for bit: Cycles' Linear "
-             "filter sums the four weighted texels in the order the four-fetch groups do)."]
+             "filter sums the four weighted texels in the order the four-fetch groups do)"
+             + ("." if v["max_rel"] < 1e-3 else "; where they differ more, the shading itself changed since the "
+                "baseline (the GGX LTC's band for r >= 0.65, the metal and dielectric shaded apart, the sheen's "
+                "layering), which this comparison of the node path does not separate.")]
     return "\n".join(lines) + "\n"

@@ -921,7 +921,9 @@ def verdict_lines(result):
               "shape: a decomposition against the brute-force integral (numpy, during this work, not part of "
               "this benchmark) put 93-99% of its squared error in the fitted lobe itself (too dark for lights low "
               "over the horizon, beside the view plane, and at grazing views), 1-9% in the clipless horizon "
-              "handling and < 0.1% in the table interpolation and the magnitude; (4) GLSL runs on llvmpipe, a "
+              "handling and < 0.1% in the table interpolation and the magnitude; for r >= 0.65 the GGX table's "
+              "band now halves it against Cycles (docs/area_lights.md, 'The band'), but this benchmark's rough "
+              "spheres (r = 0.5 and 0.6) lie below it and pay only its nodes; (4) GLSL runs on llvmpipe, a "
               "CPU rasteriser: its frames are CPU time as Cycles' samples are.", ""]
     return lines
 
