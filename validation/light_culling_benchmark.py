@@ -17,13 +17,13 @@ Writes ``light_culling.md`` and ``.json``.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
+
+from . import report
 
 
 def demo_scene(lut_dir, resolution):
@@ -169,11 +169,7 @@ def run(out=None, repeats=3, quick=False, lut_dir=None, scenes=("demo", "grid"),
             f"{result['scenes'][name]['speedup']:.2f}x faster")
     result["seconds"] = time.perf_counter() - t0
     md = markdown(result)
-    if out is not None:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "light_culling.md").write_text(md)
-        (out / "light_culling.json").write_text(json.dumps(result, indent=1))
+    report.write_results(out, "light_culling", result, md)
     log(md)
     return result
 

@@ -19,12 +19,12 @@ Writes ``light_fallback.md`` and ``.json`` in ``--out``.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
-from pathlib import Path
 
 import numpy as np
+
+from . import report
 
 ANGLE_PAIRS = ((100.0, 90.0), (120.0, 110.0), (140.0, 130.0))     # (outer, inner), degrees: the talk's
 SHAPES = {"square 1 x 1 m": (1.0, 1.0), "rectangle 2 x 0.5 m": (2.0, 0.5)}
@@ -138,11 +138,7 @@ def run(out=None, quick=False, lut_dir=None, log=print):
     result = {"quick": quick, "rows": rows, "costs": costs()}
     result["seconds"] = time.perf_counter() - t0
     md = markdown(result)
-    if out is not None:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "light_fallback.md").write_text(md)
-        (out / "light_fallback.json").write_text(json.dumps(result, indent=1))
+    report.write_results(out, "light_fallback", result, md)
     log(md)
     return result
 

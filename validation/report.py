@@ -51,6 +51,17 @@ def error_png(path, err, vmax):
     return path
 
 
+def write_results(folder, stem, result, markdown):
+    """A benchmark's ``<stem>.md`` and ``<stem>.json`` in ``folder`` (made if needed); nothing when ``folder`` is
+    None."""
+    if folder is None:
+        return
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / f"{stem}.md").write_text(markdown)
+    (folder / f"{stem}.json").write_text(json.dumps(result, indent=1, default=json_default))
+
+
 def write_csv(path, rows):
     keys = []
     for r in rows:

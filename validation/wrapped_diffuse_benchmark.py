@@ -18,11 +18,11 @@ Writes ``wrapped_diffuse.md`` and ``.json`` in ``--out``.
 from __future__ import annotations
 
 import argparse
-import json
 import time
-from pathlib import Path
 
 import numpy as np
+
+from . import report
 
 WRAPS = (0.0, 0.5, 1.0)
 ROUGHNESS = (0.3, 0.8)
@@ -186,11 +186,7 @@ def run(out=None, lights=120, quick=False, lut_dir=None, log=print):
               "albedo": albedo_rows(2 if quick else 6)}
     result["seconds"] = time.perf_counter() - t0
     md = markdown(result)
-    if out is not None:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "wrapped_diffuse.md").write_text(md)
-        (out / "wrapped_diffuse.json").write_text(json.dumps(result, indent=1))
+    report.write_results(out, "wrapped_diffuse", result, md)
     log(md)
     return result
 
