@@ -11,7 +11,15 @@ pytest.importorskip("OpenEXR")
 pytestmark = pytest.mark.blender
 
 
+#: The colour rule of Cycles' rough diffuse per release, measured with this furnace: 4.5 LTS and 5.2 LTS weight EON's
+#: multiple scattering by the albedo once more (rho x rho_ms, what RT Lit's "oren_nayar" computes); 5.3 renders EON's
+#: own rho_ms, 1-5.5% brighter at rho = 0.5, sigma = 1 than RT Lit (docs/rough_diffuse.md, "Blender 5.3").
+COLOUR_RULE = {(4, 5): "cycles", (5, 2): "cycles", (5, 3): "eon"}
+
+
 def test_furnace_identifies_cycles_rough_diffuse(empty_scene, tmp_path):
+    import bpy
+
     from rt_lookdev.validation import rough_diffuse_furnace as furnace
 
     cases = (("diffuse rho=1 sigma=1", "diffuse", 1.0, 1.0), ("principled rho=0.5 sigma=1", "principled", 0.5, 1.0))
@@ -20,7 +28,9 @@ def test_furnace_identifies_cycles_rough_diffuse(empty_scene, tmp_path):
     for row in white["bins"]:
         assert row["rendered"] == pytest.approx(1.0, abs=4 * row["se"] + 5e-4)
         assert row["fon"] < row["rendered"] - 0.04
-    assert grey["best"] == ["cycles"]
+    rule = COLOUR_RULE.get(tuple(bpy.app.version[:2]), "cycles")
+    assert grey["best"] == [rule]
+    other = "eon" if rule == "cycles" else "cycles"
     for row in grey["bins"]:
-        assert row["rendered"] == pytest.approx(row["cycles"], abs=4 * row["se"] + 5e-4)
-        assert row["eon"] > row["rendered"] + 0.005
+        assert row[rule] == pytest.approx(row["rendered"], abs=4 * row["se"] + 5e-4)
+        assert abs(row[other] - row["rendered"]) > 0.005
