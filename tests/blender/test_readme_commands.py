@@ -45,6 +45,7 @@ RUN_BY = {
     "scripts/benchmark_light_culling.py": "here",
     "scripts/validate_rough_diffuse.py": "here",
     "scripts/measure_sheen_table.py": "here",
+    "scripts/benchmark_metal_split.py": "here",
 }
 
 #: The commands run here: (script, arguments, files it must write under the output folder).
@@ -65,6 +66,7 @@ SMOKE = {
     "scripts/validate_rough_diffuse.py": (["--resolution", "24", "--samples", "8", "--out", "{out}"],
                                           ["rough_diffuse_furnace.json"]),
     "scripts/measure_sheen_table.py": (["--lut-dir", "{out}"], ["zeltner_sheen.exr", "zeltner_sheen_sh1.exr"]),
+    "scripts/benchmark_metal_split.py": (["--quick", "--out", "{out}"], ["metal_split.md", "metal_split.json"]),
 }
 
 
