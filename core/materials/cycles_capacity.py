@@ -10,6 +10,10 @@ from __future__ import annotations
 
 from .rt_lit_interface import Features
 
+#: The benchmark searches up to this many lights: a capacity equal to it means "at least this many" (the search
+#: stopped there with the material still rendering).
+SEARCHED_UP_TO = 64
+
 #: feature set -> (max quad lights, max quad lights with the World term), measured.
 MEASURED = {
     Features("single", "lambert"): (15, 15),
@@ -26,7 +30,8 @@ MEASURED = {
 _SPECULAR_COST = {"none": 0, "single": 0, "turquin": 1, "fdez_aguera": 1, "kulla_conty": 2}
 #: cod_wrapped: the CoD lobe plus the wrapped normal's tilt, costlier than either (no measured set bounds it yet,
 #: so it takes the smallest measured capacity).
-_DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1, "cod_wrapped": 2}
+#: oren_nayar: its LTC integral plus the multiple scattering's Lambert form factor, one integral more than CoD.
+_DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1, "cod_wrapped": 2, "oren_nayar": 2}
 #: The fitted Disney sheen has the talk's structure (one LTC integral, another table).  Zeltner's (turquin, cod)
 #: renders 64 quad lights, with and without the World term (the benchmark's cap; docs/sheen.md, "Cost"), so the
 #: talk's sheen's measured set bounds it too.
@@ -49,3 +54,8 @@ def light_capacity(features, world=False):
         return MEASURED[key][column], True
     bounds = [caps[column] for measured, caps in MEASURED.items() if _at_least_as_costly(measured, key)]
     return (max(bounds) if bounds else min(caps[column] for caps in MEASURED.values())), False
+
+
+def is_lower_bound(capacity):
+    """True when ``capacity`` is where the benchmark's search stopped, not where the material failed."""
+    return capacity >= SEARCHED_UP_TO

@@ -29,3 +29,16 @@ def test_unmeasured_sets_get_a_costlier_measured_bound():
     assert cycles_capacity.light_capacity(Features("turquin", "lambert", cloth=True)) == (3, False)
     # everything on but CoD instead of wrapped: the all-on row bounds it
     assert cycles_capacity.light_capacity(Features("kulla_conty", "cod", sheen=True, cloth=True)) == (3, False)
+
+
+def test_every_model_of_every_switch_gets_a_capacity():
+    """Sync Lights asks for the capacity of every RT Lit group's switches: no model may be missing from the cost
+    order (an unknown diffuse model made Sync Lights fail)."""
+    from itertools import product
+
+    from rt_lookdev.core.materials.rt_lit_interface import DIFFUSE_MODELS, SHEEN_MODELS, SPECULAR_MODELS
+
+    for spec, diffuse, sheen, cloth, world in product(SPECULAR_MODELS, DIFFUSE_MODELS, SHEEN_MODELS, (False, True),
+                                                      (False, True)):
+        lights, measured = cycles_capacity.light_capacity(Features(spec, diffuse, sheen=sheen, cloth=cloth), world)
+        assert lights >= 1 and isinstance(measured, bool)
