@@ -123,18 +123,25 @@ def _ignored_settings(records, materials):
 
 
 def _over_capacity(groups, lights, has_world):
-    """The warning for RT Lit groups whose feature set shades fewer lights in Cycles than the scene has
-    (core/materials/cycles_capacity.py: measured SVM-stack capacity), or ""."""
+    """The warning for RT Lit groups that shade more lights than their feature set holds in Cycles
+    (core/materials/cycles_capacity.py: measured SVM-stack capacity), or "".  ``lights``: the scene's lights, what
+    a group shades unless it was culled to a subset of them."""
     from ..core.materials import cycles_capacity
     from ..core.materials.rt_lit_interface import Features
-    from .common import FEATURES_KEY
+    from .common import FEATURES_KEY, LIGHTS_SUBSET_KEY
 
-    over = []
+    over = {}
     for ng in groups:
+        if ng.users == 0:                # every material using it now has a culled group: nothing renders with it
+            continue
         features = Features.from_dict(ng[FEATURES_KEY])
         capacity, measured = cycles_capacity.light_capacity(features, has_world)
-        if lights > capacity:
-            over.append(f"({features.label()}) {'at most' if measured else 'about'} {capacity}")
+        shaded = len(ng[LIGHTS_SUBSET_KEY]) if LIGHTS_SUBSET_KEY in ng else lights
+        if shaded > capacity:
+            bound = ("tested up to" if cycles_capacity.is_lower_bound(capacity) else
+                     "at most" if measured else "about")
+            over.setdefault(features.label(), f"({features.label()}) {bound} {capacity}")
+    over = list(over.values())
     if not over:
         return ""
     return (f"Cycles renders RT Lit materials black beyond their shader-stack capacity, "

@@ -36,10 +36,10 @@ from pathlib import Path
 import numpy as np
 
 from . import report
+from ..core.materials.cycles_capacity import SEARCHED_UP_TO as MAX_LIGHTS
 
 
 REPO = Path(__file__).resolve().parents[1]
-MAX_LIGHTS = 64
 RESOLUTION = (64, 64)
 HDRI, WORLD_STRENGTH = "forest", 0.5
 SVM_OVERFLOW = "out of SVM stack space"

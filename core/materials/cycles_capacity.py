@@ -4,7 +4,8 @@ Cycles' SVM keeps every live value of a material on a stack of 255 floats; an RT
 each light's terms, so past a number of lights that depends on its switches the compile fails and the
 surface renders black.  The numbers are measured by ``scripts/benchmark_rt_lit.py`` (quad lights, the
 costliest kind; docs/benchmarks/rt_lit.md, "Capacity") and checked against its JSON by
-tests/core/test_cycles_capacity.py.  EEVEE has no such limit.
+tests/core/test_cycles_capacity.py.  Measured 2026-12-02, every feature set, every technique on included, renders the
+search's cap of 64 quad lights; the warning then says how far it was tested.  EEVEE has no such limit.
 """
 from __future__ import annotations
 
@@ -16,13 +17,13 @@ SEARCHED_UP_TO = 64
 
 #: feature set -> (max quad lights, max quad lights with the World term), measured.
 MEASURED = {
-    Features("single", "lambert"): (15, 15),
-    Features("turquin", "cod"): (13, 13),
-    Features("fdez_aguera", "lambert"): (15, 14),
-    Features("kulla_conty", "lambert"): (8, 7),
-    Features("turquin", "cod", sheen=True): (10, 8),
-    Features("single", "cod", cloth=True): (10, 8),
-    Features("kulla_conty", "wrapped", sheen=True, cloth=True): (3, 3),
+    Features("single", "lambert"): (64, 64),
+    Features("turquin", "cod"): (64, 64),
+    Features("fdez_aguera", "lambert"): (64, 64),
+    Features("kulla_conty", "lambert"): (64, 64),
+    Features("turquin", "cod", sheen=True): (64, 64),
+    Features("single", "cod", cloth=True): (64, 64),
+    Features("kulla_conty", "wrapped", sheen=True, cloth=True): (64, 64),
 }
 
 # Rough cost order of the switches, for feature sets that were not measured: a measured set at least as

@@ -54,8 +54,15 @@ def test_sync_lights_with_no_lights_and_with_a_hundred(registered, empty_scene, 
     assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
     out = _reports(capfd)
     assert "RT Lit: 100 lights [100 point]" in out      # counted per kind: a list of 100 names was truncated
-    # the default switches (turquin, cod) shade at most 13 lights in Cycles (measured)
-    assert "black beyond their shader-stack capacity" in out and "(turquin, cod) at most 13" in out
+    from rt_lookdev.core.materials import cycles_capacity
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    # the default switches (turquin, cod): their measured Cycles capacity is below 100 lights, or the benchmark's
+    # search stopped below 100 (then the warning says how far it was tested)
+    capacity, _ = cycles_capacity.light_capacity(Features("turquin", "cod"))
+    bound = "tested up to" if cycles_capacity.is_lower_bound(capacity) else "at most"
+    assert capacity < 100
+    assert "black beyond their shader-stack capacity" in out and f"(turquin, cod) {bound} {capacity}" in out
     assert "docs/benchmarks/rt_lit.md" in out and "truncated" not in out
     assert len(_light_terms(bpy)) == 100
     assert mat.node_tree.nodes.get("RT Lit") is not None or any(n.bl_idname == "ShaderNodeGroup"
@@ -195,11 +202,15 @@ def test_undo_and_redo_sync_world(registered, empty_scene, tmp_path, monkeypatch
 
 
 def test_sync_lights_names_what_is_not_shaded_and_the_capacity_of_each_feature_set(registered, empty_scene,
-                                                                                    lut_dir, capfd):
-    """The Sync report says which light settings RT Lit ignores, and warns with the measured capacity of each
-    material's switches (3 lights with every technique on), not a fixed number."""
+                                                                                    lut_dir, capfd, monkeypatch):
+    """The Sync report says which light settings RT Lit ignores, and warns with the capacity of each material's
+    switches, not a fixed number.  The capacities are set small here (the measured ones, docs/benchmarks/rt_lit.md,
+    are checked by tests/core/test_cycles_capacity.py) so that a few lights exceed one set and not the other."""
+    from rt_lookdev.core.materials import cycles_capacity
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
+    monkeypatch.setitem(cycles_capacity.MEASURED, Features("kulla_conty", "wrapped", sheen=True, cloth=True), (3, 3))
+    monkeypatch.setitem(cycles_capacity.MEASURED, Features("single", "lambert"), (15, 15))
     bpy = registered
     scene = empty_scene
     _rt_lit_object(bpy, scene, lut_dir, Features("kulla_conty", "wrapped", sheen=True, cloth=True))

@@ -108,3 +108,23 @@ def test_culling_changes_no_value_and_follows_moves(empty_scene, lut_dir):
     materials.rebuild_rt_lit_groups(scene, lut_dir)
     groups = [bpy.data.materials[f"Cull {i}"].node_tree.nodes["RT Lit"].node_tree.name for i in range(3)]
     assert groups[0].endswith("[lights 3]") and groups[1].endswith("[lights 0, 1, 3]")
+
+
+def test_the_capacity_warning_counts_the_lights_each_material_shades(empty_scene, lut_dir, monkeypatch):
+    """Sync Lights warns when a material shades more lights than its switches hold in Cycles: a culled material
+    shades only the lights that reach it, and a group no material uses any more warns for nothing.  The capacity is
+    set to 3 here (the measured ones: tests/core/test_cycles_capacity.py)."""
+    import bpy
+
+    from rt_lookdev.addon import materials, operators
+    from rt_lookdev.core.materials import cycles_capacity
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    monkeypatch.setitem(cycles_capacity.MEASURED, Features("turquin", "cod"), (3, 3))
+    scene = _scene(bpy, lut_dir)                    # 4 lights; each material shades its point light and the sun
+    assert operators._over_capacity(materials.rebuild_rt_lit_groups(scene, lut_dir), 4, False) == ""
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = _scene(bpy, lut_dir, ranged=False)      # no ranges: every material shades all 4
+    warning = operators._over_capacity(materials.rebuild_rt_lit_groups(scene, lut_dir), 4, False)
+    assert "(turquin, cod) at most 3 lights" in warning

@@ -19,7 +19,14 @@ def test_table_is_the_benchmarks_measurement():
     assert measured == cycles_capacity.MEASURED
 
 
-def test_unmeasured_sets_get_a_costlier_measured_bound():
+def test_unmeasured_sets_get_a_costlier_measured_bound(monkeypatch):
+    # the mechanism, on a table where the sets differ (the measurement of 2026-11-22; today every set reaches the
+    # search's cap)
+    monkeypatch.setattr(cycles_capacity, "MEASURED", {
+        Features("single", "lambert"): (15, 15), Features("turquin", "cod"): (13, 13),
+        Features("fdez_aguera", "lambert"): (15, 14), Features("kulla_conty", "lambert"): (8, 7),
+        Features("turquin", "cod", sheen=True): (10, 8), Features("single", "cod", cloth=True): (10, 8),
+        Features("kulla_conty", "wrapped", sheen=True, cloth=True): (3, 3)})
     assert cycles_capacity.light_capacity(Features("kulla_conty", "lambert")) == (8, True)
     assert cycles_capacity.light_capacity(Features("kulla_conty", "lambert"), world=True) == (7, True)
     # turquin + lambert: the best bound among sets at least as costly is fdez-aguera + lambert's 15
@@ -42,3 +49,8 @@ def test_every_model_of_every_switch_gets_a_capacity():
                                                       (False, True)):
         lights, measured = cycles_capacity.light_capacity(Features(spec, diffuse, sheen=sheen, cloth=cloth), world)
         assert lights >= 1 and isinstance(measured, bool)
+
+
+def test_a_capacity_at_the_searchs_cap_is_a_lower_bound():
+    assert cycles_capacity.is_lower_bound(cycles_capacity.SEARCHED_UP_TO)
+    assert not cycles_capacity.is_lower_bound(cycles_capacity.SEARCHED_UP_TO - 1)
