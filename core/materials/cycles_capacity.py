@@ -29,13 +29,14 @@ MEASURED = {
 # Rough cost order of the switches, for feature sets that were not measured: a measured set at least as
 # costly in every switch bounds the capacity from below.
 _SPECULAR_COST = {"none": 0, "single": 0, "turquin": 1, "fdez_aguera": 1, "kulla_conty": 2}
-#: cod_wrapped: the CoD lobe plus the wrapped normal's tilt, costlier than either (no measured set bounds it yet,
-#: so it takes the smallest measured capacity).
-#: oren_nayar: its LTC integral plus the multiple scattering's Lambert form factor, one integral more than CoD.
+#: cod_wrapped: the CoD lobe over the light's image under the wrap, costlier than either; oren_nayar: its LTC
+#: integral plus the multiple scattering's Lambert form factor, one integral more than CoD.  No measured set bounds
+#: them, so they take the smallest measured capacity; checked with ``rt_lit_benchmark.capacity`` (2026-12-02),
+#: turquin + each renders 64 quad lights with and without the World term, as do turquin + CoD with the Zeltner and
+#: the fitted Disney sheen.
 _DIFFUSE_COST = {"lambert": 0, "cod": 1, "wrapped": 1, "cod_wrapped": 2, "oren_nayar": 2}
-#: The fitted Disney sheen has the talk's structure (one LTC integral, another table).  Zeltner's (turquin, cod)
-#: renders 64 quad lights, with and without the World term (the benchmark's cap; docs/sheen.md, "Cost"), so the
-#: talk's sheen's measured set bounds it too.
+#: The fitted Disney sheen has the talk's structure (one LTC integral, another table); Zeltner's is bounded by the
+#: talk's sheen's measured set too (docs/sheen.md, "Cost").
 _SHEEN_COST = {"none": 0, "disney_talk": 1, "disney_fitted": 1, "zeltner": 1}
 
 
