@@ -29,7 +29,7 @@ def interface(shader):
     """The uniform interface of a ``MaterialShader`` as plain data."""
     return {"material": shader.material.name, "features": shader.material.features.as_dict(),
             "light_slots": [{"kind": kind, "uniform": f"{rt_lit_shader.light_array(kind)}[{index}]",
-                             "struct": rt_lit_shader.LIGHT_STRUCTS[kind],
+                             "struct": rt_lit_shader.light_struct(kind),
                              "fields": [{"field": f, "type": t, "parameters": [p for p, _ in parts]}
                                         for f, t, parts in rt_lit_shader.light_fields(kind)]}
                             for kind, index in shader.light_slots],

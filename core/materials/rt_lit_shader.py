@@ -46,8 +46,8 @@ _VECTOR_FIELDS = {
     "Scale": ("scale", "vec3", "XYZ"),
     "Color": ("color", "vec3", "RGB"),
 }
-#: The struct of each base light kind (a kind with options gets its own: ``light_struct``) and its uniform array.
-LIGHT_STRUCTS = {"quad": "RtlAreaLight", "disk": "RtlAreaLight", "point": "RtlPointLight", "spot": "RtlSpotLight",
+#: The struct of each base light kind; every kind's, options included, is ``light_struct(kind)``.
+_BASE_STRUCTS = {"quad": "RtlAreaLight", "disk": "RtlAreaLight", "point": "RtlPointLight", "spot": "RtlSpotLight",
                  "sun": "RtlSunLight", "quad_spot": "RtlQuadSpotLight"}
 _WORLD_SH = 9
 
@@ -61,7 +61,7 @@ def light_struct(kind):
     """The struct of ``kind``'s lights: its base kind's, with the options' names for a kind with options
     ("RtlAreaLightConeRange": its fields are the base's plus the options' parameters)."""
     base, options = lights.split_kind(kind)
-    return LIGHT_STRUCTS[base] + "".join(o.capitalize() for o in options)
+    return _BASE_STRUCTS[base] + "".join(o.capitalize() for o in options)
 
 
 def light_fields(kind):
@@ -350,7 +350,7 @@ def interface_markdown(shader):
     lines += [f"| `{u.name}` | `{u.type}` | {u.meaning.replace('|', '/')} |" for u in shader.uniforms]
     structs = {}
     for kind, _ in shader.light_slots:
-        structs.setdefault(LIGHT_STRUCTS[kind], kind)
+        structs.setdefault(light_struct(kind), kind)
     lines += ["", "| struct | field | type | Blender parameter (core/lights.py) |", "|---|---|---|---|"]
     for struct, kind in structs.items():
         for field, typ, parts in light_fields(kind):

@@ -4,6 +4,11 @@ material for several feature sets and light lists (fragment and vertex shader), 
 3.00 and HLSL.  A refused shader fails with glslang's log and the source lines it names."""
 from __future__ import annotations
 
+import importlib.util
+import itertools
+import json
+from pathlib import Path
+
 import pytest
 
 from rt_lookdev.core.ir import shader_text, trace
@@ -106,29 +111,85 @@ def test_a_refused_shader_names_its_line(glslang_path):
     assert "undefined_name" in message and "    5      o = vec4(undefined_name);" in message
 
 
-def test_export_shader_script_writes_what_compiles(glslang_path, tmp_path, lut_dir):
-    """scripts/export_shader.py: shaders in every dialect, interface.json and the LUT files they sample."""
-    import importlib.util
-    import json
-    from pathlib import Path
+EXPORT_SHADER = Path(__file__).parents[2] / "scripts" / "export_shader.py"
+#: The files of each dialect scripts/export_shader.py writes: (fragment, vertex).
+EXPORTED = {"glsl450": ("glsl450.frag", "glsl450.vert"), "glsl300es": ("glsl300es.frag", "glsl300es.vert"),
+            "hlsl": ("ps.hlsl", "vs.hlsl")}
 
-    spec = importlib.util.spec_from_file_location("export_shader", Path(__file__).parents[2] / "scripts" / "export_shader.py")
+
+def _export_shader_script():
+    spec = importlib.util.spec_from_file_location("export_shader", EXPORT_SHADER)
     script = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(script)
+    return script
+
+
+def _compile_export(out):
+    for dialect, (frag, vert) in EXPORTED.items():
+        glslang.compile_source((out / f"rt_lit.{frag}").read_text(), "frag", dialect)
+        glslang.compile_source((out / f"rt_lit.{vert}").read_text(), "vert", dialect)
+
+
+def test_export_shader_script_writes_what_compiles(glslang_path, tmp_path, lut_dir):
+    """scripts/export_shader.py: shaders in every dialect, interface.json and the LUT files they sample."""
     out = tmp_path / "shaders"
-    assert script.main(["--out", str(out), "--lights", "quad,sun", "--specular", "kulla_conty", "--cloth",
-                        "--lut-dir", str(lut_dir)]) == 0
+    assert _export_shader_script().main(["--out", str(out), "--lights", "quad,sun", "--specular", "kulla_conty",
+                                         "--cloth", "--lut-dir", str(lut_dir)]) == 0
     data = json.loads((out / "interface.json").read_text())
     assert [s["uniform"] for s in data["light_slots"]] == ["u_quad_lights[0]", "u_sun_lights[0]"]
     for name, entry in data["tables"].items():
         assert (out / entry["file"]).is_file(), name
-    for dialect, (frag, vert) in {"glsl450": ("glsl450.frag", "glsl450.vert"),
-                                  "glsl300es": ("glsl300es.frag", "glsl300es.vert"),
-                                  "hlsl": ("ps.hlsl", "vs.hlsl")}.items():
-        glslang.compile_source((out / f"rt_lit.{frag}").read_text(), "frag", dialect)
-        glslang.compile_source((out / f"rt_lit.{vert}").read_text(), "vert", dialect)
-    assert script.main(["--out", str(tmp_path / "bad"), "--lights", "tube"]) == 2
+    _compile_export(out)
+    assert _export_shader_script().main(["--out", str(tmp_path / "bad"), "--lights", "tube"]) == 2
     assert not (tmp_path / "bad").exists()
+
+
+def _kinds_with_options():
+    """Every light kind with each combination of the options it takes (core/lights.py OPTION_KINDS)."""
+    from rt_lookdev.core import lights
+
+    combos = [c for n in range(1, len(lights.LIGHT_OPTIONS) + 1) for c in itertools.combinations(lights.LIGHT_OPTIONS, n)]
+    kinds = dict.fromkeys(lights.kind_name(base, c) for base in lights.LIGHT_DATA for c in combos)
+    return [k for k in kinds if lights.split_kind(k)[1]]
+
+
+def test_export_shader_script_exports_every_light_kind_with_options(glslang_path, tmp_path, lut_dir):
+    """--lights quad+range, disk+cone+range, ... (what --help and the error for a bad kind suggest): each kind with
+    options has its own struct and array, in the shaders and in interface.json, and the shaders compile."""
+    from rt_lookdev.core import lights
+    from rt_lookdev.core.materials import rt_lit_shader
+
+    kinds = _kinds_with_options()
+    assert {"quad+range", "quad+cone+range", "disk+cone", "point+range", "spot+range", "quad_spot+range"} <= set(kinds)
+    out = tmp_path / "shaders"
+    assert _export_shader_script().main(["--out", str(out), "--lights", ",".join(["quad"] + kinds),
+                                         "--lut-dir", str(lut_dir)]) == 0
+    data = json.loads((out / "interface.json").read_text())
+    assert [s["kind"] for s in data["light_slots"]] == ["quad"] + kinds
+    fragment = (out / "rt_lit.glsl450.frag").read_text()
+    for slot in data["light_slots"][1:]:
+        kind = slot["kind"]
+        base, options = lights.split_kind(kind)
+        assert slot["struct"] == rt_lit_shader.light_struct(kind) != rt_lit_shader.light_struct(base)
+        assert slot["uniform"] == f"{rt_lit_shader.light_array(kind)}[0]"
+        assert f"struct {slot['struct']} {{" in fragment and f" {rt_lit_shader.light_array(kind)}[1];" in fragment
+        parameters = {p for f in slot["fields"] for p in f["parameters"]}
+        assert ("Range" in parameters) == ("range" in options)
+        assert {"Cone Inner", "Cone Outer"} <= parameters or "cone" not in options
+    _compile_export(out)
+
+
+def test_interface_table_names_the_struct_of_each_light_kind():
+    """rt_lit_shader.interface_markdown (docs/realtime.md's table) for kinds with options: their structs' fields."""
+    from rt_lookdev.core.materials import rt_lit, rt_lit_shader
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    kinds = _kinds_with_options()
+    shader = rt_lit_shader.material_shader(rt_lit.build_rt_lit(Features(), kinds, None))
+    table = rt_lit_shader.interface_markdown(shader)
+    for kind in kinds:
+        assert f"| `{rt_lit_shader.light_struct(kind)}` | `location` | `vec3` |" in table, kind
+    assert "| `RtlAreaLightConeRange` | `range` | `float` | Range |" in table
 
 
 def test_docs_show_the_interface_the_code_emits(tmp_path):
