@@ -1,7 +1,7 @@
 """Write the RT Lit material's shaders for an engine: GLSL 4.50, GLSL ES 3.00 and HLSL fragment and
 vertex shaders, the uniform interface (interface.json) and the LUT files they sample.
 
-    python scripts/export_shader.py --out DIR [--specular turquin] [--diffuse cod] [--sheen] [--cloth]
+    python scripts/export_shader.py --out DIR [--specular turquin] [--diffuse cod] [--sheen [zeltner]] [--cloth]
                                     [--lights quad,disk,point,spot,sun] [--dialects glsl450,glsl300es,hlsl]
                                     [--world ENV.exr --world-table NAME] [--no-precise] [--lut-dir DIR]
 

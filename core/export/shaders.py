@@ -78,13 +78,16 @@ def write_material_shaders(folder, material, dialects=tuple(EXTENSIONS), luts=No
 
 def parse_args(argv):
     """The options of scripts/export_shader.py."""
-    from ..materials.rt_lit_interface import DIFFUSE_MODELS, LIGHT_KINDS, SPECULAR_MODELS
+    from ..materials.rt_lit_interface import (DIFFUSE_MODELS, LIGHT_KINDS, PRINCIPLED_SHEEN, SHEEN_MODELS,
+                                              SPECULAR_MODELS)
 
     p = argparse.ArgumentParser(description="Write the RT Lit material's shaders, interface and tables for an engine")
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--specular", default="turquin", choices=SPECULAR_MODELS)
     p.add_argument("--diffuse", default="cod", choices=DIFFUSE_MODELS)
-    p.add_argument("--sheen", action="store_true")
+    p.add_argument("--sheen", nargs="?", default="none", const=PRINCIPLED_SHEEN, choices=SHEEN_MODELS,
+                   help=f"the sheen model (default none); --sheen alone: {PRINCIPLED_SHEEN}, Principled's sheen, as "
+                        "Convert gives a Principled material with sheen (the talk's Disney sheen is disney_talk)")
     p.add_argument("--cloth", action="store_true")
     p.add_argument("--lights", default="quad,disk", help=f"light kinds in order, from {', '.join(LIGHT_KINDS)}; options as quad+cone+range")
     p.add_argument("--dialects", default=",".join(EXTENSIONS))

@@ -29,6 +29,8 @@ DIFFUSE_MODELS += ("oren_nayar",)
 #: sheen (Burley 2012) with its own fitted LTC under area lights; Disney sheen as the talk shades it (the CoD
 #: table at r = 0.5 under area lights).  A stored ``sheen: true`` (the old switch) is "disney_talk".
 SHEEN_MODELS = ("none", "zeltner", "disney_fitted", "disney_talk")
+#: The sheen model of Blender's Principled BSDF: what a conversion picks for a Principled material with sheen.
+PRINCIPLED_SHEEN = "zeltner"
 #: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
 #: the prefiltered radiance (the talk's approximation); core/materials/world.py.
 ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")

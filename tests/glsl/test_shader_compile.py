@@ -179,6 +179,31 @@ def test_export_shader_script_exports_every_light_kind_with_options(glslang_path
     _compile_export(out)
 
 
+def test_export_shader_script_takes_every_model(tmp_path, lut_dir):
+    """--sheen takes a sheen model; alone it is the Zeltner sheen, as Convert gives a Principled material (the old
+    bare --sheen, the talk's Disney sheen, is disney_talk); --diffuse and --specular take every model."""
+    from rt_lookdev.core.export import shaders
+    from rt_lookdev.core.materials import rt_lit_interface as iface
+
+    def parsed(*args):
+        return shaders.parse_args(["--out", str(tmp_path / "x"), *args])
+
+    assert iface.PRINCIPLED_SHEEN == "zeltner"
+    assert parsed().sheen == "none"
+    assert parsed("--sheen").sheen == parsed("--sheen", "--cloth").sheen == "zeltner"
+    assert parsed("--sheen", "--cloth").cloth
+    for name, models in (("sheen", iface.SHEEN_MODELS), ("diffuse", iface.DIFFUSE_MODELS),
+                         ("specular", iface.SPECULAR_MODELS)):
+        for model in models:
+            assert getattr(parsed(f"--{name}", model), name) == model
+    out = tmp_path / "sheen"
+    assert _export_shader_script().main(["--out", str(out), "--sheen", "--lights", "quad", "--dialects", "glsl450",
+                                         "--lut-dir", str(lut_dir)]) == 0
+    data = json.loads((out / "interface.json").read_text())
+    assert data["features"]["sheen"] == "zeltner" and "zeltner sheen" in data["material"]
+    assert "zeltner_sheen.exr" in {entry["file"] for entry in data["tables"].values()}
+
+
 def test_interface_table_names_the_struct_of_each_light_kind():
     """rt_lit_shader.interface_markdown (docs/realtime.md's table) for kinds with options: their structs' fields."""
     from rt_lookdev.core.materials import rt_lit, rt_lit_shader
