@@ -7,6 +7,8 @@ from __future__ import annotations
 import importlib.util
 import itertools
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -140,8 +142,6 @@ def test_export_shader_script_writes_what_compiles(glslang_path, tmp_path, lut_d
     for name, entry in data["tables"].items():
         assert (out / entry["file"]).is_file(), name
     _compile_export(out)
-    assert _export_shader_script().main(["--out", str(tmp_path / "bad"), "--lights", "tube"]) == 2
-    assert not (tmp_path / "bad").exists()
 
 
 def _kinds_with_options():
@@ -202,6 +202,39 @@ def test_export_shader_script_takes_every_model(tmp_path, lut_dir):
     data = json.loads((out / "interface.json").read_text())
     assert data["features"]["sheen"] == "zeltner" and "zeltner sheen" in data["material"]
     assert "zeltner_sheen.exr" in {entry["file"] for entry in data["tables"].values()}
+
+
+#: Bad values of scripts/export_shader.py and what its one-line error must name.
+BAD_EXPORT_ARGS = {
+    "unknown dialect": (["--dialects", "glsl,hlsl"], "argument --dialects: unknown dialects glsl; choose from "
+                                                     "glsl450, glsl300es, hlsl"),
+    "no dialect": (["--dialects", ","], "argument --dialects: no dialect; choose from glsl450, glsl300es, hlsl"),
+    "unknown light kind": (["--lights", "quad,tube"], "argument --lights: unknown light kind 'tube' (known: quad, "),
+    "option a kind lacks": (["--lights", "sun+range"], "light kind 'sun' has no option 'range'; the options, in this "
+                                                       "order: +cone on quad, disk; +range on quad, disk, point"),
+    "sheen model": (["--sheen", "velvet"], "argument --sheen: invalid choice: 'velvet'"),
+    "missing world": (["--world", "{tmp}/none.exr"], "argument --world: {tmp}/none.exr does not exist; it takes a "
+                                                     "world bake's prefiltered EXR"),
+    "world not an EXR": (["--world", "{tmp}/text.exr"], "argument --world: {tmp}/text.exr is not a world bake's "
+                                                         "prefiltered EXR"),
+    "world a LUT": (["--world", "{luts}/ggx_one_minus_E.exr"], "holds the table 'ggx_one_minus_E', not prefiltered "
+                                                                "levels"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_EXPORT_ARGS))
+def test_export_shader_script_refuses_bad_values_in_one_line(case, tmp_path, lut_dir):
+    """A bad --dialects, --lights, --sheen or --world: argparse's one-line error naming the valid values or what
+    is wrong with the file, exit code 2, no traceback and nothing written."""
+    args, message = BAD_EXPORT_ARGS[case]
+    (tmp_path / "text.exr").write_text("not an image")
+    fill = {"tmp": tmp_path, "luts": lut_dir}
+    proc = subprocess.run([sys.executable, str(EXPORT_SHADER), "--out", str(tmp_path / "out"),
+                           *(a.format(**fill) for a in args)], capture_output=True, text=True, timeout=60)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    assert lines[-1].startswith("export_shader.py: error: ") and message.format(**fill) in lines[-1], lines[-1]
+    assert not (tmp_path / "out").exists()
 
 
 def test_interface_table_names_the_struct_of_each_light_kind():
