@@ -1,10 +1,10 @@
 """Headless validation of the RT Lit material (issue 5): node render vs numpy vs ground truth.
 
-Runs a seeded built-in suite (scripts/validation_suite.py ``build_cases``): rows of unit spheres,
+Runs a seeded built-in suite (validation/suite_cases.py ``build_cases``): rows of unit spheres,
 one per technique variant, under quad and disk area lights of several sizes, distances and tilts
 (every sphere also sees the light partly below its horizon near the terminator), a roughness sweep
 of dielectrics and metals, point / spot / sun lights, and wrap, cloth, sheen, CoD and Kulla-Conty
-variants.  Per case three images (details in validation_suite.py):
+variants.  Per case three images (details in suite_cases.py):
 
   (a) Cycles render of the RT Lit material (emission only, 1 sample at pixel centres);
   (b) numpy evaluation of the same IR at (a)'s Position / Normal passes;

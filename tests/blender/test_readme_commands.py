@@ -105,3 +105,18 @@ def test_readme_command_runs(script, tmp_path):
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     for name in outputs:
         assert (out / name).stat().st_size > 0, name
+
+
+def test_every_script_named_exists():
+    """Every scripts/<name>.py or .sh that the README, the docs, CI, the code or the tests name exists (the --help
+    texts are the code's docstrings; validate.py's named a suite script that had moved into validation/)."""
+    texts = [REPO / "README.md", REPO / ".ci" / "run", *sorted((REPO / "docs").rglob("*.md")),
+             *sorted((REPO / "scripts").glob("*.sh"))]
+    texts += [p for folder in ("core", "addon", "node_groups", "validation", "scripts", "tests")
+              for p in sorted((REPO / folder).rglob("*.py"))]
+    named = {}
+    for path in texts:
+        for name in re.findall(r"scripts/[A-Za-z_0-9]+\.(?:py|sh)", path.read_text()):
+            named.setdefault(name, set()).add(path.relative_to(REPO).as_posix())
+    missing = {name: sorted(where) for name, where in named.items() if not (REPO / name).is_file()}
+    assert named and not missing, missing
