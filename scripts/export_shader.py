@@ -2,7 +2,7 @@
 vertex shaders, the uniform interface (interface.json) and the LUT files they sample.
 
     python scripts/export_shader.py --out DIR [--specular turquin] [--diffuse cod] [--sheen [zeltner]] [--cloth]
-                                    [--lights quad,disk,point,spot,sun] [--dialects glsl450,glsl300es,hlsl]
+                                    [--lights quad+cone+range,disk,point,spot,sun] [--dialects glsl450,glsl300es,hlsl]
                                     [--world ENV.exr --world-table NAME] [--no-precise] [--lut-dir DIR]
 
 Entry point of ``rt_lookdev.core.export.shaders``; ``--help`` lists the options."""

@@ -174,7 +174,7 @@ def markdown(result):
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="docs/benchmarks", help="folder for light_fallback.md / .json")
     p.add_argument("--quick", action="store_true", help="a coarser floor")
     p.add_argument("--lut-dir", default=None)

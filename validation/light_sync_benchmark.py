@@ -135,7 +135,7 @@ def format_markdown(r):
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--objects", type=int, default=100)
     p.add_argument("--lights", type=int, default=10)
     p.add_argument("--repeats", type=int, default=200)
