@@ -32,6 +32,7 @@ import math
 import bpy
 
 from . import compat
+from .light_model import link_states
 
 #: Sphere roughness along each row.
 ROUGHNESS = (0.05, 0.25, 0.5, 0.75, 1.0)
@@ -317,20 +318,6 @@ def twin_material(material):
             del twin[key]
     twin[TWIN_SOURCE_KEY] = material.name
     return twin
-
-
-def link_states(collection):
-    """{object pointer: (object, "INCLUDE" or "EXCLUDE")} of a light-linking ``collection`` as Blender reads it
-    (source/blender/depsgraph/intern/depsgraph_light_linking.cc): an object of a child collection, at any depth,
-    has that child's state, an object of the collection itself its own; a later entry wins, the collection's own
-    objects coming after its children."""
-    states = {}
-    for child, entry in zip(collection.children, collection.collection_children):
-        for obj in child.all_objects:
-            states[obj.as_pointer()] = (obj, entry.light_linking.link_state)
-    for obj, entry in zip(collection.objects, collection.collection_objects):
-        states[obj.as_pointer()] = (obj, entry.light_linking.link_state)
-    return states
 
 
 def _reachable(objects):

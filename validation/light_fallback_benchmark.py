@@ -39,7 +39,8 @@ def _light_params(size, size_y, outer, inner, height, power=100.0):
     return {"Location X": 0.0, "Location Y": 0.0, "Location Z": height, "Rotation W": 1.0, "Rotation X": 0.0,
             "Rotation Y": 0.0, "Rotation Z": 0.0, "Scale X": 1.0, "Scale Y": 1.0, "Scale Z": 1.0, "Power": power,
             "Color R": 1.0, "Color G": 1.0, "Color B": 1.0, "Size": size, "Size Y": size_y,
-            "Cone Inner": math.radians(inner), "Cone Outer": math.radians(outer)}
+            "Cone Inner": math.radians(inner), "Cone Outer": math.radians(outer), "Exposure": 0.0, "Normalize": 1.0,
+            "Determinant": 1.0}
 
 
 def _floor(points, height):

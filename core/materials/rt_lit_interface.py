@@ -98,9 +98,10 @@ RT_LIT_GROUP_PREFIX = "RT Lit"
 RADIANCE_OUTPUT = "Radiance"
 EMISSION_OUTPUT = "Material Emission"
 WORLD_OUTPUT = "World Radiance"
-#: The light kinds RT Lit shades (area quad and disk, point, spot, sun, and the talk's quad-to-spot fallback:
-#: core/lights.py).  A kind may carry build-time options, "quad+cone+range" (``core.lights.split_kind``).
-LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad_spot")
+#: The light kinds RT Lit shades (area quad and disk, point, spot, sun, the talk's quad-to-spot fallback, and
+#: Blender's point and spot lights with a radius and suns with an angle: core/lights.py).  A kind may carry
+#: build-time options, "quad+cone+range" (``core.lights.split_kind``).
+LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad_spot", "sphere", "spot_sphere", "sun_disk")
 
 
 def light_input(index, parameter):

@@ -48,7 +48,8 @@ _VECTOR_FIELDS = {
 }
 #: The struct of each base light kind; every kind's, options included, is ``light_struct(kind)``.
 _BASE_STRUCTS = {"quad": "RtlAreaLight", "disk": "RtlAreaLight", "point": "RtlPointLight", "spot": "RtlSpotLight",
-                 "sun": "RtlSunLight", "quad_spot": "RtlQuadSpotLight"}
+                 "sun": "RtlSunLight", "quad_spot": "RtlQuadSpotLight", "sphere": "RtlSphereLight",
+                 "spot_sphere": "RtlSpotSphereLight", "sun_disk": "RtlSunDiskLight"}
 _WORLD_SH = 9
 
 
@@ -69,7 +70,7 @@ def light_fields(kind):
     (core/lights.py ``light_data``); component None for a scalar field."""
     fields, seen = [], {}
     for param in lights.light_data(kind).input_sockets:
-        if param == "Position":
+        if param in lights.SHADING_POINT_INPUTS:
             continue
         word, _, axis = param.partition(" ")
         if word in _VECTOR_FIELDS and len(axis) == 1:

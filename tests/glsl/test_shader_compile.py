@@ -246,7 +246,7 @@ def test_interface_table_names_the_struct_of_each_light_kind():
     shader = rt_lit_shader.material_shader(rt_lit.build_rt_lit(Features(), kinds, None))
     table = rt_lit_shader.interface_markdown(shader)
     for kind in kinds:
-        assert f"| `{rt_lit_shader.light_struct(kind)}` | `location` | `vec3` |" in table, kind
+        assert f"| `{rt_lit_shader.light_struct(kind)}` | `color` | `vec3` |" in table, kind
     assert "| `RtlAreaLightConeRange` | `range` | `float` | Range |" in table
 
 
