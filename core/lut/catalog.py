@@ -16,6 +16,7 @@ import ast
 import hashlib
 import io
 import json
+import shutil
 import tokenize
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -312,8 +313,6 @@ def keep_measured(lut_dir, log=print):
     """Measured tables are never computed by the bake (``core.lut_bake`` knows only ``GROUPS``): in
     ``lut_dir`` each is kept when current, else copied from the shipped folder when that one is intact;
     otherwise ``log`` says how to get it back.  Returns {group: "kept" | "copied" | "missing"}."""
-    import shutil
-
     out = {}
     shipped = default_lut_dir()
     for name, group in MEASURED_GROUPS.items():
