@@ -4,10 +4,10 @@
                                       [--out DIR] [--lut-dir DIR]
     blender --background --python scripts/validate_energy.py -- [same options]
 
-Entry point of ``rt_lookdev.validation.energy_render``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.energy_render``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import energy_render
+from rt_lookdev.validation.checks import energy_render
 
 
 def main(argv):

@@ -5,10 +5,10 @@ candidate models (Lambert, Fujii's Oren-Nayar, EON, Cycles' variant).
     .venvs/blender-4.5/bin/python scripts/validate_rough_diffuse.py [same options]   (Blender 4.5's Cycles; the
                                                      venv is built by bash scripts/test.sh --release 4.5)
 
-Entry point of ``rt_lookdev.validation.rough_diffuse_furnace``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.rough_diffuse_furnace``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import rough_diffuse_furnace
+from rt_lookdev.validation.checks import rough_diffuse_furnace
 
 
 def main(argv):

@@ -17,7 +17,7 @@ Steps (each prints what it does):
    quad and a disk light, saved to <out>/demo/lookdev_demo.blend; node counts, Cycles render time,
    one EEVEE render compared with Cycles; the scene exported (<out>/demo/realtime_scene) and drawn by
    the GLSL backend's standalone renderer, compared with Cycles.
-7. The lookdev scene of "New Lookdev Scene" against its path-traced twin (validation/lookdev_twin.py):
+7. The lookdev scene of "New Lookdev Scene" against its path-traced twin (validation/checks/lookdev_twin.py):
    RT Lit in Cycles vs Cycles path tracing of the Principled twin, with and without the spheres'
    shadows, and EEVEE vs Cycles; <out>/lookdev/ and the pictures of docs/images/lookdev_*.png.
 8. Real-time backend, quick benchmark (scripts/benchmark_realtime.py --quick): frame time of the
@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import report
+from .harness import report
 
 
 from ..core import multiscatter
@@ -111,7 +111,7 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
 
 def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
     log("[6/13] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
-    from . import demo_measure as demo_report
+    from .checks import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
     result["summary_markdown"] = demo_report.format_markdown(result, image_prefix="demo/")
@@ -120,7 +120,7 @@ def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
 
 def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
     log("[7/13] lookdev scene (New Lookdev Scene) vs its path-traced twin, Cycles and EEVEE")
-    from . import lookdev_twin
+    from .checks import lookdev_twin
 
     result = lookdev_twin.run(out_dir / "lookdev", lut_dir=lut_dir, eevee=eevee, pictures_dir=REPO / "docs" / "images",
                               log=log)
@@ -163,7 +163,7 @@ def step_lut_export(out_dir, lut_dir, log=report.flush_log):
 def step_robustness(out_dir, lut_dir, log=report.flush_log):
     log("[11/13] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
         "(scripts/robustness_sweep.py --points 2000)")
-    from . import robustness
+    from .checks import robustness
 
     out = out_dir / "benchmarks" / "robustness.md"
     argv = ["--points", "2000", "--out", str(out)] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
@@ -185,7 +185,7 @@ def step_robustness(out_dir, lut_dir, log=report.flush_log):
 def step_speed_error(out_dir, lut_dir, eevee=True, log=report.flush_log):
     log("[12/13] speed vs error, quick: RT Lit's backends against path tracing at equal error "
         "(scripts/benchmark_speed_error.py --quick)")
-    from . import speed_error
+    from .benchmarks import speed_error
 
     folder = out_dir / "benchmarks" / "speed_error"
     cache = out_dir / "validation_world" / "env_cache"           # the world validation's bakes, when there
@@ -202,7 +202,8 @@ def step_speed_error(out_dir, lut_dir, eevee=True, log=report.flush_log):
 
 def step_realtime_benchmark(out_dir, log=report.flush_log):
     log("[8/13] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
-    from . import glsl_runner, realtime_benchmark
+    from .harness import glsl_runner
+    from .benchmarks import realtime_benchmark
 
     glsl_runner.disable_shader_cache()
     ok, why = glsl_runner.available()
@@ -229,7 +230,7 @@ def _run_suite(module, folder, lut_dir, log):
 
 def step_validation(out_dir, lut_dir, log=report.flush_log):
     log("[9/13] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
-    from . import suite
+    from .checks import suite
 
     result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
     return {"passed": bool(result["passed"]), "checks": result["checks"],
@@ -238,7 +239,7 @@ def step_validation(out_dir, lut_dir, log=report.flush_log):
 
 def step_world_validation(out_dir, lut_dir, log=report.flush_log):
     log("[10/13] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
-    from . import world_suite
+    from .checks import world_suite
 
     result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
     report_md = out_dir / "validation_world" / "report.md"
@@ -248,7 +249,7 @@ def step_world_validation(out_dir, lut_dir, log=report.flush_log):
 
 def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
     log("[5/13] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
-    from . import energy_render as validate_energy
+    from .checks import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
     result = validate_energy.run(out_dir=out_dir / "energy_render", lut_dir=lut_dir,
@@ -259,7 +260,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
 
 def step_ltc(lut_dir, log=report.flush_log):
     log("[3/13] LTC area lights: random quads and disks vs brute force")
-    from . import ltc_benchmark as benchmark_ltc
+    from .benchmarks import ltc_benchmark as benchmark_ltc
 
     t0 = time.perf_counter()
     tables = {name: benchmark_ltc.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}

@@ -116,7 +116,7 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
                                 sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_prefix, ()))
 
 #: Cycles' sheen (Zeltner, Burley & Chiang 2022): the LTC (a, b) and albedo of each (mu, r), measured from
-#: Cycles renders (validation/sheen_table.py); 32 x 32 nodes at i/31 as Cycles' own table, so a bilinear
+#: Cycles renders (validation/benchmarks/sheen_table.py); 32 x 32 nodes at i/31 as Cycles' own table, so a bilinear
 #: lookup reproduces Cycles' exactly.  ``params`` say what was measured, with which Blender.
 ZELTNER_SHEEN_SIZE = 32
 #: Measured groups, apart from ``GROUPS`` (what ``core.lut_bake`` computes): ``keep_measured`` keeps them.

@@ -302,7 +302,7 @@ def _rough_diffuse_multiscatter_world(coeffs, n, surface, ms_weight):
     return op.scale(op.vmul(color, lobe), ms_weight)
 # Zeltner 2022 sheen under the world (core/sheen.py): its exact integral against the L2 SH radiance.  L2 radiance
 # is a polynomial of degree 2 in the direction, so int L D = sum_i c_i E_D[Y_i] needs only D's first and second
-# moments (tables zeltner_sheen_sh1/2, computed per cell from the measured LTC: validation/sheen_table.py), taken
+# moments (tables zeltner_sheen_sh1/2, computed per cell from the measured LTC: validation/benchmarks/sheen_table.py), taken
 # from the local frame (T1, T2, N) to the world's here.  Against Cycles under two studio HDRIs (docs/sheen.md):
 # median 21% (studio, r = 0.5) and 7.9% (sunset, r = 0.2) where the talk's cosine lobe about the LTC's peak gave
 # 49% and 28%; what remains is the L2 truncation of the environment.

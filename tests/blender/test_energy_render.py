@@ -14,7 +14,7 @@ import pytest
 
 pytest.importorskip("OpenEXR")
 
-from rt_lookdev.validation import energy_render as ve  # noqa: E402
+from rt_lookdev.validation.checks import energy_render as ve  # noqa: E402
 
 pytestmark = pytest.mark.blender
 

@@ -19,7 +19,7 @@ FALLBACK = {"rtl_spot_fallback": True, "rtl_cone_inner": math.radians(100.0), "r
 
 
 def _case():
-    from rt_lookdev.validation import suite_cases as suite
+    from rt_lookdev.validation.checks import suite_cases as suite
 
     lights = [suite.LightSpec("quad", (1.5, -3.2, 1.6), 400.0, 1.6, 1.0, controls={**RANGE, **CONE}),
               suite.LightSpec("disk", (-2.5, -2.0, 1.0), 300.0, 1.0, controls=CONE),
@@ -31,8 +31,8 @@ def _case():
 
 
 def _passes_and_numpy(scene, case, tables):
-    from rt_lookdev.validation import suite_cases as suite
-    from rt_lookdev.validation.engines import render_cycles_passes
+    from rt_lookdev.validation.checks import suite_cases as suite
+    from rt_lookdev.validation.harness.engines import render_cycles_passes
 
     res = (scene.render.resolution_x, scene.render.resolution_y)
     passes = render_cycles_passes(scene, res)
@@ -73,8 +73,8 @@ def test_controls_render_like_numpy_follow_edits_and_reload_without_python(empty
     import bpy
 
     from rt_lookdev.addon import materials
-    from rt_lookdev.validation import suite_cases as suite
-    from rt_lookdev.validation.engines import render_reloaded
+    from rt_lookdev.validation.checks import suite_cases as suite
+    from rt_lookdev.validation.harness.engines import render_reloaded
 
     case = _case()
     scene, _ = suite.build_scene(case, 40, 48, 24, lut_dir)

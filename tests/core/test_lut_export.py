@@ -144,7 +144,7 @@ def read_ltc_code_dds(path):
 
 
 def test_ltc_code_layout_gives_the_rtl_figures(export_ltc_code, lut_dir):
-    from rt_lookdev.validation import ltc_benchmark
+    from rt_lookdev.validation.benchmarks import ltc_benchmark
 
     rtl = {name: ltc_benchmark.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}
     swapped = {}
@@ -161,7 +161,7 @@ def test_ltc_code_layout_gives_the_rtl_figures(export_ltc_code, lut_dir):
 def test_ltc_code_layout_matches_the_published_table(export_ltc_code):
     """Our ltc_1 read as the published one is, beside the published GGX table: the same channels in the same
     places (its transpose, or the view axis flipped, is far off)."""
-    from rt_lookdev.validation import published_ltc
+    from rt_lookdev.validation.harness import published_ltc
 
     try:
         ltc1, _ = published_ltc.load_anchor()

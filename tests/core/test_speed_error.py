@@ -1,10 +1,10 @@
-"""The speed-vs-error benchmark's arithmetic (validation/speed_error.py) on made-up ladders: the equal-error
+"""The speed-vs-error benchmark's arithmetic (validation/benchmarks/speed_error.py) on made-up ladders: the equal-error
 interpolation and its bounds, the noise correction, the decay exponent, the families, the summary table."""
 import math
 
 import pytest
 
-from rt_lookdev.validation import speed_error as se
+from rt_lookdev.validation.benchmarks import speed_error as se
 
 
 def _ladder(k=1.0, e1=0.5, top=256, fixed=0.1, per_sample=0.01, noise=0.0):
