@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .harness import report
+from .harness import entry
 
 
 from ..core import multiscatter
@@ -64,7 +64,7 @@ LTC_MEDIAN_TOL = {"ggx": 0.015, "cod_diffuse": 0.01, "cloth": 0.01}   # quads, l
 LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main job
 
 
-def step_luts(lut_dir, log=report.flush_log):
+def step_luts(lut_dir, log=entry.flush_log):
     log(f"[1/13] LUTs in {lut_dir}")
 
     def progress(group, done, total):
@@ -78,7 +78,7 @@ def step_luts(lut_dir, log=report.flush_log):
             "passed": all(s.state == "ok" for s in status)}
 
 
-def step_numpy_checks(lut_dir, log=report.flush_log):
+def step_numpy_checks(lut_dir, log=entry.flush_log):
     log("[2/13] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
@@ -109,7 +109,7 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
     return out
 
 
-def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
+def step_demo(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[6/13] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
     from .checks import demo_measure as demo_report
 
@@ -118,7 +118,7 @@ def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
     return result
 
 
-def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
+def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[7/13] lookdev scene (New Lookdev Scene) vs its path-traced twin, Cycles and EEVEE")
     from .checks import lookdev_twin
 
@@ -130,7 +130,7 @@ def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
     return result
 
 
-def step_lut_export(out_dir, lut_dir, log=report.flush_log):
+def step_lut_export(out_dir, lut_dir, log=entry.flush_log):
     log("[4/13] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
     from ..core.export import luts as lut_export
 
@@ -160,7 +160,7 @@ def step_lut_export(out_dir, lut_dir, log=report.flush_log):
     return out
 
 
-def step_robustness(out_dir, lut_dir, log=report.flush_log):
+def step_robustness(out_dir, lut_dir, log=entry.flush_log):
     log("[11/13] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
         "(scripts/robustness_sweep.py --points 2000)")
     from .checks import robustness
@@ -182,7 +182,7 @@ def step_robustness(out_dir, lut_dir, log=report.flush_log):
             "passed": result["failures"] == 0, "summary_markdown": text}
 
 
-def step_speed_error(out_dir, lut_dir, eevee=True, log=report.flush_log):
+def step_speed_error(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[12/13] speed vs error, quick: RT Lit's backends against path tracing at equal error "
         "(scripts/benchmark_speed_error.py --quick)")
     from .benchmarks import speed_error
@@ -200,7 +200,7 @@ def step_speed_error(out_dir, lut_dir, eevee=True, log=report.flush_log):
             "seconds": result["seconds"], "summary_markdown": text}
 
 
-def step_realtime_benchmark(out_dir, log=report.flush_log):
+def step_realtime_benchmark(out_dir, log=entry.flush_log):
     log("[8/13] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
     from .harness import glsl_runner
     from .benchmarks import realtime_benchmark
@@ -228,7 +228,7 @@ def _run_suite(module, folder, lut_dir, log):
     return result, lines
 
 
-def step_validation(out_dir, lut_dir, log=report.flush_log):
+def step_validation(out_dir, lut_dir, log=entry.flush_log):
     log("[9/13] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
     from .checks import suite
 
@@ -237,7 +237,7 @@ def step_validation(out_dir, lut_dir, log=report.flush_log):
             "summary_markdown": "\n".join(lines) + f"\n\nFull report: `{out_dir / 'validation' / 'report.html'}`."}
 
 
-def step_world_validation(out_dir, lut_dir, log=report.flush_log):
+def step_world_validation(out_dir, lut_dir, log=entry.flush_log):
     log("[10/13] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
     from .checks import world_suite
 
@@ -247,7 +247,7 @@ def step_world_validation(out_dir, lut_dir, log=report.flush_log):
             "summary_markdown": "\n".join(lines) + f"\n\nFull report (per HDRI and roughness): `{report_md}`."}
 
 
-def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
+def step_render(out_dir, lut_dir, resolution, samples, log=entry.flush_log):
     log("[5/13] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
     from .checks import energy_render as validate_energy
 
@@ -258,7 +258,7 @@ def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
     return result
 
 
-def step_ltc(lut_dir, log=report.flush_log):
+def step_ltc(lut_dir, log=entry.flush_log):
     log("[3/13] LTC area lights: random quads and disks vs brute force")
     from .benchmarks import ltc_benchmark as benchmark_ltc
 
@@ -366,7 +366,7 @@ def _passed(job):
                                   "world_validation", "robustness", "speed_error")))
 
 
-def run(args, log=report.flush_log):
+def run(args, log=entry.flush_log):
     """Every step, then the report (``args.out``/report.md, report.json).  Returns the report dict; when
     the LUTs are not usable, stops after step 1 with ``{"luts": ..., "passed": False}`` (no report)."""
     t0 = time.perf_counter()

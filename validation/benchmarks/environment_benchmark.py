@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import report
+from ..harness import entry
 
 from ...core.environment import equirect, prefilter, sh  # noqa: E402
 
@@ -128,7 +128,7 @@ def large_source_rows(tmp, default_cap, log=print):
 CHECK_R = (0.125, 0.5, 1.0)
 
 
-def hdri_rows(normals, dirs, settings, tmp, log=report.flush_log, names=None):
+def hdri_rows(normals, dirs, settings, tmp, log=entry.flush_log, names=None):
     """Per studio HDRI (``names``: a subset): (name, SH irradiance mean / p90 / max relative error, SH bake s,
     prefiltered bake s, cached re-run s), and (name, [relative errors of the prefiltered lookup per
     ``CHECK_R``])."""
@@ -163,7 +163,7 @@ def hdri_rows(normals, dirs, settings, tmp, log=report.flush_log, names=None):
     return rows, pf_rows
 
 
-def method_rows(log=report.flush_log):
+def method_rows(log=entry.flush_log):
     """Importance sampling vs the FFT quadrature (exact at texel centres) on one HDRI, per roughness:
     [r, FFT s, FFT max rel vs brute force, then per (samples, bias): samples, bias, s, mean, p90]."""
     image = equirect.read_equirect(equirect.resolve_hdri("sunset"))
@@ -291,7 +291,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(args, log=report.flush_log):
+def run(args, log=entry.flush_log):
     """Measure, write ``args.out`` (Markdown) and the JSON beside it; returns the JSON's dict."""
     settings = prefilter.PrefilterSettings()
     with tempfile.TemporaryDirectory() as tmp:

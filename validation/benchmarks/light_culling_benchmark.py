@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from ..harness import report
+from ..harness import outputs
 
 
 def demo_scene(lut_dir, resolution):
@@ -169,7 +169,7 @@ def run(out=None, repeats=3, quick=False, lut_dir=None, scenes=("demo", "grid"),
             f"{result['scenes'][name]['speedup']:.2f}x faster")
     result["seconds"] = time.perf_counter() - t0
     md = markdown(result)
-    report.write_results(out, "light_culling", result, md)
+    outputs.write_results(out, "light_culling", result, md)
     log(md)
     return result
 

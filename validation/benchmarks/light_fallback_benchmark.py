@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from ..harness import report
+from ..harness import outputs
 
 ANGLE_PAIRS = ((100.0, 90.0), (120.0, 110.0), (140.0, 130.0))     # (outer, inner), degrees: the talk's
 SHAPES = {"square 1 x 1 m": (1.0, 1.0), "rectangle 2 x 0.5 m": (2.0, 0.5)}
@@ -140,7 +140,7 @@ def run(out=None, quick=False, lut_dir=None, log=print):
     result = {"quick": quick, "rows": rows, "costs": costs()}
     result["seconds"] = time.perf_counter() - t0
     md = markdown(result)
-    report.write_results(out, "light_fallback", result, md)
+    outputs.write_results(out, "light_fallback", result, md)
     log(md)
     return result
 

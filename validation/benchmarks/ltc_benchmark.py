@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import report
+from ..harness import entry, outputs
 
 from ..harness import png as _png
 
@@ -463,7 +463,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(args, log=report.flush_log):
+def run(args, log=entry.flush_log):
     """Measure, write ltc.json, ltc.md and the heat maps to ``args.out``; returns the results."""
     args.out.mkdir(parents=True, exist_ok=True)
     import os
@@ -563,7 +563,7 @@ def rough_diffuse_area_forms(tables, n_quads, n_disks, seed=2024):
     return results
 
 
-def run_lobes(args, res, log=report.flush_log):
+def run_lobes(args, res, log=entry.flush_log):
     """``--lobes``: the fit error and random-light error of the named lobes' tables (and the rough diffuse's
     area forms), into ltc_<lobes>.md / .json; the other tables' ltc.md is not touched."""
     prefixes = [p for p, (lobe, _) in catalog.LTC_LOBES.items() if lobe in args.lobes]
@@ -582,7 +582,7 @@ def run_lobes(args, res, log=report.flush_log):
         log("[bench] the rough diffuse's area forms ...")
         res["rough_diffuse"] = rough_diffuse_area_forms(tables, 60 if args.quick else 300, 30 if args.quick else 150)
     stem = "ltc_" + "_".join(args.lobes)
-    (args.out / f"{stem}.json").write_text(json.dumps(res, indent=2, default=report.json_default))
+    (args.out / f"{stem}.json").write_text(json.dumps(res, indent=2, default=outputs.json_default))
     write_lobes_markdown(res, args.out / f"{stem}.md", args)
     log((args.out / f"{stem}.md").read_text())
     return res

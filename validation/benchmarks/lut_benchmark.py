@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import report
+from ..harness import entry
 
 
 from ...core import energy
@@ -146,7 +146,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(args, log=report.flush_log):
+def run(args, log=entry.flush_log):
     """Measure, write luts.json and luts.md to ``args.out``; returns the results."""
     args.out.mkdir(parents=True, exist_ok=True)
     res = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",

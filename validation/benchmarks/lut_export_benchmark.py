@@ -28,7 +28,7 @@ from ...core.ir.tables import Table
 from ...core.lut import catalog
 from ...core.lut.lookup import LutSet
 from . import ltc_benchmark
-from ..harness import report
+from ..harness import entry
 
 REPO = Path(__file__).resolve().parents[2]
 VARIANTS = ("f32", "f16 plain", "f16 scaled")
@@ -66,7 +66,7 @@ def furnaces(arrays, reference):
             "fdez_aguera_rel_change": float(np.max(np.abs(f - f0) / np.abs(f0)))}
 
 
-def run(args, log=report.flush_log):
+def run(args, log=entry.flush_log):
     lut_dir = args.lut_dir or catalog.default_lut_dir()
     t0 = time.perf_counter()
     tables = luts.layout_tables(LutSet.from_folder(lut_dir), "rtl")

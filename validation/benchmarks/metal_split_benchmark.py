@@ -22,7 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..harness import report
+from ..harness import entry, outputs
 
 REPO = Path(__file__).resolve().parents[2]
 #: How the specular of a partly metallic surface is shaded: the one mixed F0 (before) or each F0 apart (shipped).
@@ -92,7 +92,7 @@ def markdown(result):
     return "\n".join(L) + "\n"
 
 
-def run(out=None, quick=False, log=report.flush_log):
+def run(out=None, quick=False, log=entry.flush_log):
     t0 = time.perf_counter()
     cases = QUICK_CASES if quick else CASES
     result = {"quick": quick, "cases": list(cases)}
@@ -101,7 +101,7 @@ def run(out=None, quick=False, log=report.flush_log):
             result[shading] = _run_child(shading, cases, Path(tmp) / shading, log)
     result["seconds"] = time.perf_counter() - t0
     md = markdown(result)
-    report.write_results(out, "metal_split", result, md)
+    outputs.write_results(out, "metal_split", result, md)
     log(md)
     return result
 

@@ -36,7 +36,7 @@ from ...core.export import scene as scene_io
 from ...core.lut import catalog, exr_io
 from ...core.materials import rt_lit
 from ...core.materials.rt_lit_interface import Features, LIGHT_KINDS
-from ..harness import glsl_runner, grids, report
+from ..harness import entry, glsl_runner, grids
 
 REPO = Path(__file__).resolve().parents[2]
 FEATURE_SETS = {"minimal": (Features("single", "lambert"), False),
@@ -260,7 +260,7 @@ def _machine():
     return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(), "numpy": np.__version__}
 
 
-def run(args, log=report.flush_log):
+def run(args, log=entry.flush_log):
     glsl_runner.disable_shader_cache()
     ok, why = glsl_runner.available()
     if not ok:

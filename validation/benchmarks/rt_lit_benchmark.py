@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import report
+from ..harness import entry
 from ...core.materials.cycles_capacity import SEARCHED_UP_TO as MAX_LIGHTS
 
 
@@ -395,7 +395,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(args, log=report.flush_log):
+def run(args, log=entry.flush_log):
     """Measure every feature set, write rt_lit.json and rt_lit.md to ``args.out``; returns the JSON's dict."""
     quick = getattr(args, "quick", False)
     reps = 1 if quick else args.repeats

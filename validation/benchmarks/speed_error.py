@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import report
+from ..harness import entry, outputs
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -1199,7 +1199,7 @@ def run(out_dir, lut_dir=None, quick=True, log=print, cases=None, cell=None, thr
     result["passed"] = all(np.isfinite(b[m]) for c in records for v in c["variants"] for b in v["backends"].values()
                            for m in METRICS) and bool(records)
     result["plots"] = plot_families(result, out_dir)
-    (out_dir / "speed_error.json").write_text(json.dumps(result, indent=1, default=report.json_default))
+    (out_dir / "speed_error.json").write_text(json.dumps(result, indent=1, default=outputs.json_default))
     (out_dir / "speed_error.md").write_text(format_markdown(result, image_prefix))
     log(f"[speed] {len(records)} cases in {result['seconds']:.0f} s; {out_dir / 'speed_error.md'}")
     return result
@@ -1229,7 +1229,7 @@ def parse_args(argv):
     return args
 
 
-def run_args(args, log=report.flush_log):
+def run_args(args, log=entry.flush_log):
     """``run`` with the options of ``parse_args``; logs the family table; returns the result."""
     result = run(args.out, args.lut_dir, args.quick, log, args.cases, args.cell, args.threads, not args.skip_eevee,
                  not args.skip_glsl, args.env_cache,

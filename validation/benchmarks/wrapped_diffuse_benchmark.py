@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from ..harness import report
+from ..harness import outputs
 
 WRAPS = (0.0, 0.5, 1.0)
 ROUGHNESS = (0.3, 0.8)
@@ -186,7 +186,7 @@ def run(out=None, lights=120, quick=False, lut_dir=None, log=print):
               "albedo": albedo_rows(2 if quick else 6)}
     result["seconds"] = time.perf_counter() - t0
     md = markdown(result)
-    report.write_results(out, "wrapped_diffuse", result, md)
+    outputs.write_results(out, "wrapped_diffuse", result, md)
     log(md)
     return result
 

@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import report
+from ..harness import outputs
 
 
 
@@ -430,7 +430,7 @@ def run(resolution=256, samples=256, roughness=(0.25, 0.5, 0.75, 1.0), out_dir=N
     results["timings_s"] = {"luts": t_luts, "exact_reference": t_exact, "build_scene": t_build,
                             "renders": timings, "analyse": t_analyse,
                             "total": time.perf_counter() - t_start}
-    (out_dir / "energy_validation.json").write_text(json.dumps(results, indent=2, default=report.json_default))
+    (out_dir / "energy_validation.json").write_text(json.dumps(results, indent=2, default=outputs.json_default))
     log(format_table(results))
     return results
 

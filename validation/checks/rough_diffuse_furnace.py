@@ -30,7 +30,7 @@ import numpy as np
 
 from ...core import rough_diffuse
 from . import energy_render
-from ..harness import report
+from ..harness import outputs
 
 #: (label, node, rho, sigma): the spheres, left to right.
 DEFAULT_CASES = (
@@ -132,7 +132,7 @@ def run(cases=DEFAULT_CASES, resolution=96, samples=64, seeds=(0, 1), threads=2,
     bpy = energy_render._bpy()
     res = {"blender": bpy.app.version_string, "resolution_per_sphere": resolution, "samples": samples,
            "seeds": list(seeds[:2]), "cases": analyse(renders, cases), "seconds": time.perf_counter() - t0}
-    (out_dir / "rough_diffuse_furnace.json").write_text(json.dumps(res, indent=2, default=report.json_default))
+    (out_dir / "rough_diffuse_furnace.json").write_text(json.dumps(res, indent=2, default=outputs.json_default))
     log(format_table(res))
     return res
 

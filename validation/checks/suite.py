@@ -66,10 +66,8 @@ from pathlib import Path
 
 import numpy as np
 
-
-
-from ..harness import report
-from . import suite_cases as suite
+from ..harness import outputs
+from . import suite_cases as suite, suite_html
 
 DEFAULTS = {"ab_tol": 1e-4, "ab_atol": 1e-6, "lambert_median": 0.005, "ggx_quad_median": 0.02,
             "ggx_quad_p90": 0.12, "furnace_tol": 0.005, "floor": 0.1, "floor_wide": 0.01}
@@ -213,14 +211,14 @@ def _variant_entries(case, args, a, b, index, t):
 
 def _write_case_images(case, args, folder, a, b, c, index):
     """node_a.exr, numpy_b.exr, truth_c.exr and the PNG previews and error maps; returns the PNG names."""
-    report.write_exr(folder / "node_a.exr", a)
-    report.write_exr(folder / "numpy_b.exr", b)
-    report.write_exr(folder / "truth_c.exr", c)
+    outputs.write_exr(folder / "node_a.exr", a)
+    outputs.write_exr(folder / "numpy_b.exr", b)
+    outputs.write_exr(folder / "truth_c.exr", c)
     hit = index >= 0
     scale = float(np.percentile(a[hit], 99)) if hit.any() else 1.0
     png = {"a": "a.png", "c": "c.png", "err_ac": "err_ac.png", "err_ab": "err_ab.png"}
-    report.preview_png(folder / "a.png", np.where(hit[..., None], a, 0.0), scale)
-    report.preview_png(folder / "c.png", np.where(hit[..., None] & ~np.isfinite(c), 0.0, np.nan_to_num(c)), scale)
+    outputs.preview_png(folder / "a.png", np.where(hit[..., None], a, 0.0), scale)
+    outputs.preview_png(folder / "c.png", np.where(hit[..., None] & ~np.isfinite(c), 0.0, np.nan_to_num(c)), scale)
     with np.errstate(invalid="ignore", divide="ignore"):
         cmax = np.zeros(len(case.variants))
         for i in range(len(case.variants)):
@@ -229,8 +227,8 @@ def _write_case_images(case, args, folder, a, b, c, index):
         floor = np.where(hit, cmax[np.maximum(index, 0)] * args.floor_wide, np.inf)[..., None]
         err = np.where((c > floor) & np.isfinite(c), np.abs(a - c) / c, 0.0).max(axis=-1)
         err_ab = (np.abs(a - b) / np.maximum(np.abs(b), 1e-2)).max(axis=-1) * hit
-    report.error_png(folder / "err_ac.png", np.minimum(err, ERR_VMAX), ERR_VMAX)
-    report.error_png(folder / "err_ab.png", np.minimum(err_ab, args.ab_tol), args.ab_tol)
+    outputs.error_png(folder / "err_ac.png", np.minimum(err, ERR_VMAX), ERR_VMAX)
+    outputs.error_png(folder / "err_ab.png", np.minimum(err_ab, args.ab_tol), args.ab_tol)
     return png
 
 
@@ -578,7 +576,7 @@ def run(args, log=print):
     result["timings_s"] = {"total": time.perf_counter() - t_start,
                            "cases": {c["name"]: c["time_build"] + c["time_a"] + c["time_b"] + sum(c["time_c_cycles"])
                                      + c["time_c_brute"] + c["time_brute_check"] for c in results}}
-    (out_dir / "validation.json").write_text(json.dumps(result, indent=1, default=report.json_default))
+    (out_dir / "validation.json").write_text(json.dumps(result, indent=1, default=outputs.json_default))
     rows = []
     for c in results:
         for v in c["variants"]:
@@ -594,8 +592,8 @@ def run(args, log=print):
                          **{f"ac_wide_{k}": tw.get(k) for k in ("median", "p90")},
                          "brute_vs_cycles_median": (v.get("brute_check") or {}).get("median"),
                          "time_a": c["time_a"], "time_b": c["time_b"], "time_c": v.get("time_c")})
-    report.write_csv(out_dir / "validation.csv", rows)
-    report.write_html(out_dir / "report.html", result)
+    outputs.write_csv(out_dir / "validation.csv", rows)
+    suite_html.write_html(out_dir / "report.html", result)
     if getattr(args, "write_gates", False) and not args.quick and not args.cases:
         repo = Path(__file__).resolve().parents[2]
         (repo / "validation" / "checks" / "suite_gates.py").write_text(gates_module(result))

@@ -61,7 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import report
+from ..harness import outputs
 from . import suite_cases as suite
 from . import world_cases as vw
 
@@ -473,21 +473,21 @@ def _write_world_images(folder, nr, truth, c_full, args):
     """node_a.exr, numpy_b.exr, a.png, err_ab.png and, with a truth, truth_c.exr, c.png, err_ac.png;
     returns the PNGs by key."""
     a, b, index = nr.a, nr.b, nr.index
-    report.write_exr(folder / "node_a.exr", a)
-    report.write_exr(folder / "numpy_b.exr", b)
+    outputs.write_exr(folder / "node_a.exr", a)
+    outputs.write_exr(folder / "numpy_b.exr", b)
     hit = index >= 0
     scale = float(np.percentile(a[hit], 99)) if hit.any() else 1.0
     png = {"a": "a.png", "err_ab": "err_ab.png"}
-    report.preview_png(folder / "a.png", np.where(hit[..., None], a, 0.0), scale)
+    outputs.preview_png(folder / "a.png", np.where(hit[..., None], a, 0.0), scale)
     with np.errstate(invalid="ignore", divide="ignore"):
         err_ab = (np.abs(a - b) / np.maximum(np.abs(b), 1e-2)).max(axis=-1) * hit
-    report.error_png(folder / "err_ab.png", np.minimum(err_ab, args.ab_tol), args.ab_tol)
+    outputs.error_png(folder / "err_ab.png", np.minimum(err_ab, args.ab_tol), args.ab_tol)
     if truth is not None:
-        report.write_exr(folder / "truth_c.exr", truth["mean"])
-        report.preview_png(folder / "c.png", np.nan_to_num(c_full), scale)
+        outputs.write_exr(folder / "truth_c.exr", truth["mean"])
+        outputs.preview_png(folder / "c.png", np.nan_to_num(c_full), scale)
         with np.errstate(invalid="ignore", divide="ignore"):
             err = np.where(np.isfinite(c_full) & (c_full > 0), np.abs(a - c_full) / c_full, np.nan).max(axis=-1)
-        report.error_png(folder / "err_ac.png", np.minimum(np.nan_to_num(err), ERR_VMAX), ERR_VMAX)
+        outputs.error_png(folder / "err_ac.png", np.minimum(np.nan_to_num(err), ERR_VMAX), ERR_VMAX)
         png.update({"c": "c.png", "err_ac": "err_ac.png"})
     return png
 
@@ -549,8 +549,8 @@ def run_furnace(args, out_dir, tables, log=print):
     b, cond = _numpy_b(scene, variants, nb, passes, index, tables, env, params)
     ab_all, ab_ok = _ab_all(a, b, index, cond, args)
     rows = [_furnace_row(v, index == i, a, b, args) for i, v in enumerate(variants)]
-    report.write_exr(folder / "node_a.exr", a)
-    report.preview_png(folder / "a.png", np.where((index >= 0)[..., None], a, 0.0), 1.0)
+    outputs.write_exr(folder / "node_a.exr", a)
+    outputs.preview_png(folder / "a.png", np.where((index >= 0)[..., None], a, 0.0), 1.0)
     out = {"variants": rows, "ab": ab_all, "ab_ok": bool(ab_ok), "image": list(nb.resolution),
            "ok": all(r["ok"] for r in rows if r["gated"]), "seconds": time.perf_counter() - t0,
            "png": {"a": "furnace/a.png"}}
@@ -873,12 +873,12 @@ def _md_timings(result):
 def _html(result, md_text):
     """report.html: the markdown tables as preformatted text, the checks, and the images per world."""
     out = [f"<!doctype html><html><head><meta charset='utf-8'><title>RT Lit World validation</title>"
-           f"<style>{report._CSS}</style></head><body><h1>RT Lit World term: validation</h1>",
-           f"<p>Overall: {report._ok(result['passed'])}; {result['timings_s']['total']:.0f} s.</p>",
+           f"<style>{outputs.CSS}</style></head><body><h1>RT Lit World term: validation</h1>",
+           f"<p>Overall: {outputs.html_verdict(result['passed'])}; {result['timings_s']['total']:.0f} s.</p>",
            "<table><tr><th>check</th><th>measured</th><th>threshold</th><th></th></tr>"]
     for c in result["checks"]:
         out.append(f"<tr><td class='l'>{html.escape(c['name'])}</td><td>{html.escape(c['measured'])}</td>"
-                   f"<td>{html.escape(c['threshold'])}</td><td>{report._ok(c['ok'])}</td></tr>")
+                   f"<td>{html.escape(c['threshold'])}</td><td>{outputs.html_verdict(c['ok'])}</td></tr>")
     out.append("</table>")
     for w in _with_furnace(result):
         out.append(f"<h3>{html.escape(w['description'])}</h3>")
@@ -1043,7 +1043,7 @@ def _write_reports(out_dir, result):
     """report.md, report.json and report.html."""
     md = _tables(result)
     (out_dir / "report.md").write_text(md)
-    (out_dir / "report.json").write_text(json.dumps(result, indent=1, default=report.json_default))
+    (out_dir / "report.json").write_text(json.dumps(result, indent=1, default=outputs.json_default))
     (out_dir / "report.html").write_text(_html(result, md))
 
 
