@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from ..harness import outputs
+from ..harness import outputs, scene_render
 
 
 def demo_scene(lut_dir, resolution):
@@ -50,7 +50,6 @@ def grid_scene(lut_dir, resolution, rows=4, columns=4, spacing=4.0, light_range=
 
     from ...addon import compat, materials
     from ...core.materials.rt_lit_interface import Features
-    from ..checks import energy_render
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
@@ -65,7 +64,7 @@ def grid_scene(lut_dir, resolution, rows=4, columns=4, spacing=4.0, light_range=
             light.location = (centre[0][c] + 0.8, -1.5, centre[1][r] + 0.8)
             scene.collection.objects.link(light)
     materials.sync_scene_lights(scene)
-    mesh = energy_render._uv_sphere_mesh(bpy, "grid_sphere", 64, 32)
+    mesh = scene_render.uv_sphere_mesh("grid_sphere", 64, 32)
     for r in range(rows):
         mat = compat.new_material(f"Row {r}")
         materials.assign_rt_lit(mat, Features("turquin", "cod"), scene, lut_dir)

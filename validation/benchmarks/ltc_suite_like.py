@@ -107,10 +107,10 @@ def _local(frame, d):
 
 def _rule(light, p, n, panels, order):
     """Unit directions from p and solid-angle weights of the light clipped at the horizon of normal n (the suite's
-    brute-force rule, ``suite_cases._rule``), or None."""
+    brute-force rule, ``suite_cases.quadrature_rule``), or None."""
     geo = ({"corners": light["corners"]} if light["kind"] == "quad"
            else {"center": light["center"], "u": light["axis_u"], "v": light["axis_v"]})
-    rule = suite_cases._rule(light["kind"], geo, p, n, panels, order)
+    rule = suite_cases.quadrature_rule(light["kind"], geo, p, n, panels, order)
     if rule is None or len(rule[1]) == 0:
         return None
     x, w, normal = rule

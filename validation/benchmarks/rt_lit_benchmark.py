@@ -43,7 +43,7 @@ REPO = Path(__file__).resolve().parents[2]
 RESOLUTION = (64, 64)
 HDRI, WORLD_STRENGTH = "forest", 0.5
 SVM_OVERFLOW = "out of SVM stack space"
-#: World setups of ``_scene``: no world; the HDRI world but RT Lit without World term (no sync); both.
+#: World setups of ``lights_scene``: no world; the HDRI world but RT Lit without World term (no sync); both.
 NO_WORLD, HDRI_ONLY, WORLD_TERM = "none", "hdri", "term"
 
 VALUES = {"Base Color": (0.7, 0.3, 0.2, 1.0), "Metallic": 0.3, "Roughness": 0.35, "Wrap": 0.4,
@@ -68,7 +68,9 @@ def _world(scene, mode):
             raise RuntimeError(f"the {HDRI} world is not usable: {rtl_world.world_setup(scene.world).reason}")
 
 
-def _scene(features, count, world=NO_WORLD):
+def lights_scene(features, count, world=NO_WORLD):
+    """A fresh scene: one sphere with an RT Lit material of ``features`` before ``count`` quad lights on a circle,
+    the world of ``world`` (NO_WORLD, HDRI_ONLY or WORLD_TERM); returns (scene, material)."""
     from ...addon import compat
     import bmesh
     import bpy
@@ -111,7 +113,7 @@ def _scene(features, count, world=NO_WORLD):
 
 
 @contextlib.contextmanager
-def _captured_output():
+def captured_output():
     """Collect what the process writes to fd 1 and 2 (Cycles logs there from C++); yields a list that
     holds the text afterwards."""
     text = []
@@ -139,9 +141,9 @@ def _renders(features, count, repeats=1, world=NO_WORLD, detail=False):
     {"svm_overflow": Cycles logged it}."""
     from ..harness.engines import render_engines
 
-    scene, mat = _scene(features, count, world)
+    scene, mat = lights_scene(features, count, world)
     times, image = [], None
-    with _captured_output() as log:
+    with captured_output() as log:
         for _ in range(repeats):
             out = render_engines(scene, engines=("CYCLES",), resolution=RESOLUTION)
             image, seconds = out["CYCLES"]
@@ -202,13 +204,13 @@ def timed(features, configs, rounds):
     with tempfile.TemporaryDirectory(prefix="rtl-benchmark-") as tmp:
         files = {}
         for count, world in configs:
-            _scene(features, count, world)
+            lights_scene(features, count, world)
             files[(count, world)] = str(Path(tmp) / f"{count}_{world}.blend")
             bpy.ops.wm.save_as_mainfile(filepath=files[(count, world)], copy=True)
         for _ in range(rounds):
             for cfg, path in files.items():
                 bpy.ops.wm.open_mainfile(filepath=path)
-                with _captured_output():
+                with captured_output():
                     for _ in range(2):
                         image, seconds = render_engines(bpy.context.scene, engines=("CYCLES",),
                                                         resolution=RESOLUTION)["CYCLES"]
@@ -230,7 +232,7 @@ def ir_counts(features, lights=1):
 
     counts = {}
     for world in (NO_WORLD, WORLD_TERM):
-        _scene(features, lights, world)
+        lights_scene(features, lights, world)
         kinds = tuple(kind for _, kind in materials.synced_light_kinds())
         env = world_sync.world_environment()[0] if world == WORLD_TERM else None
         ng = bpy.data.node_groups[rt_lit_group_name(features)]

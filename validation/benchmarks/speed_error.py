@@ -7,7 +7,7 @@ seed=0)``; quad, disk and point lights, the variants with a Cycles closure: Lamb
 Turquin vs Multiscatter GGX), worlds of the world validation (a studio HDRI as the only light), and, in
 the full mode, the demo scene (``addon/demo_scene.py``) against its Principled twin:
 
-- ground truth: Cycles path tracing of the equivalent closures (``suite_cases._closure_material``,
+- ground truth: Cycles path tracing of the equivalent closures (``harness.closures.closure_material``,
   ``world_cases.closure_material``; for the demo the Principled BSDF each RT Lit material was converted
   from, ``lookdev_scene.add_path_traced_twin``), direct light only, two seeds, with its own noise
   (|c1 - c2| / 2 relative, the suite's metric, and the FLIP between the two seeds);
@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import entry, outputs
+from ..harness import closures, entry, metrics, outputs
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -193,8 +193,8 @@ def _prepare_suite(spec, cell, lut_dir):
     scene, spheres = suite.build_scene(case, cell, 192, 96, lut_dir)
     kinds = tuple(case.light_kinds)
     records = [_variant_record("suite", v.technique, v.roughness, v.label, v.features, kinds) for v in variants]
-    closures = [suite._closure_material(v, f"RTL_se_closure_{i}") for i, v in enumerate(variants)]
-    return Prepared(spec, scene, scene, spheres, records, [o.data.materials[0] for o in spheres], closures,
+    truth_closures = [closures.closure_material(v, f"RTL_se_closure_{i}") for i, v in enumerate(variants)]
+    return Prepared(spec, scene, scene, spheres, records, [o.data.materials[0] for o in spheres], truth_closures,
                     light_kinds=kinds, floor_mode="max")
 
 
@@ -213,9 +213,9 @@ def _prepare_world(spec, cell, lut_dir, cache_dir):
                               vw.sphere_mesh(192, 96))
     vw.frame(scene, block, [block])
     records = [_variant_record("world", v.technique, v.roughness, v.label, v.features) for v in variants]
-    closures = [vw.closure_material(v.closure, f"RTL_se_closure_{i}") for i, v in enumerate(variants)]
+    truth_closures = [vw.closure_material(v.closure, f"RTL_se_closure_{i}") for i, v in enumerate(variants)]
     return Prepared(spec, scene, scene, block.objects, records, [o.data.materials[0] for o in block.objects],
-                    closures, world=(env, vw.world_params_numpy(params)), floor_mode="median",
+                    truth_closures, world=(env, vw.world_params_numpy(params)), floor_mode="median",
                     light_kinds=("world",))
 
 
@@ -276,7 +276,6 @@ def render(scene, spp, seed, folder, threads=2, passes=False):
     from ...addon import compat
     from ..harness import exr_images
     from ..harness.engines import output_settings
-    from ..checks.lookdev_twin import _object_index
     from ..checks.suite_cases import configure_truth_render
 
     w, h = scene.render.resolution_x, scene.render.resolution_y
@@ -295,7 +294,7 @@ def render(scene, spp, seed, folder, threads=2, passes=False):
     if passes:
         out["position"] = exr_images.find_pass(ch, "Position", "XYZ").astype(np.float64)
         out["normal"] = exr_images.find_pass(ch, "Normal", "XYZ").astype(np.float64)
-        out["index"] = np.rint(_object_index(ch)[..., 0]).astype(int)
+        out["index"] = np.rint(exr_images.object_index_pass(ch)[..., 0]).astype(int)
     path.unlink()
     return out
 
@@ -715,8 +714,6 @@ def decay_exponent(rungs, i):
 
 def run_case(spec, plan_, luts, folder, threads=2, cache_dir=None, eevee=True, glsl=True, log=print):
     """Build the case, run the backends, the references and the ladder; returns the case's record."""
-    from ..checks.lookdev_twin import _interior
-
     t_case = time.perf_counter()
     phases = {}
     clock = [time.perf_counter()]
@@ -750,7 +747,7 @@ def run_case(spec, plan_, luts, folder, threads=2, cache_dir=None, eevee=True, g
                    for k, s in enumerate(REF_SEEDS)]
     ref_seconds = time.perf_counter() - t0
     same = ref_renders[0]["index"] == index               # both renders must see the same sphere
-    interior = _interior(np.where(same, index, 0))
+    interior = metrics.interior_pixels(np.where(same, index, 0))
     masks = [interior & (index == i + 1) for i in range(n)]
     ref = make_reference(prep, ref_renders, masks, index > 0)
     phase("reference")

@@ -1,7 +1,7 @@
 """How RT Lit's cost grows: Cycles render time and node count against lights, resolution and features,
 and EEVEE's shader compile time per material (issue 15, "Scaling").
 
-One sphere with one RT Lit material (``rt_lit_benchmark._scene``: quad lights on a circle in front of
+One sphere with one RT Lit material (``rt_lit_benchmark.lights_scene``: quad lights on a circle in front of
 it, values that keep every lobe alive) rendered by Cycles at 1 sample, 2 threads.  Each timed scene is
 built once and saved; each of ``rounds`` interleaved rounds opens every file and renders it twice,
 timing the second (the first after a load also loads images), so load on the machine affects all
@@ -59,13 +59,13 @@ def timed_configs(configs, rounds, log=print):
     "nodes": {"Cycles": n, "EEVEE": n}}}."""
     import bpy
 
-    from .rt_lit_benchmark import _captured_output, _scene
+    from .rt_lit_benchmark import captured_output, lights_scene
 
     out = {}
     with tempfile.TemporaryDirectory(prefix="rtl-scaling-") as tmp:
         files = {}
         for key, (features, lights, _) in configs.items():
-            _, mat = _scene(features, lights)
+            _, mat = lights_scene(features, lights)
             out[key] = {"runs": [], "nodes": _tree_counts(mat)}
             files[key] = str(Path(tmp) / f"{len(files)}.blend")
             bpy.ops.wm.save_as_mainfile(filepath=files[key], copy=True)
@@ -73,7 +73,7 @@ def timed_configs(configs, rounds, log=print):
             for key, path in files.items():
                 bpy.ops.wm.open_mainfile(filepath=path)
                 resolution = configs[key][2]
-                with _captured_output():
+                with captured_output():
                     _render_seconds(bpy.context.scene, "CYCLES", resolution)
                     out[key]["runs"].append(_render_seconds(bpy.context.scene, "CYCLES", resolution))
             log(f"      scaling: round {r + 1}/{rounds}")
@@ -88,7 +88,7 @@ def eevee_compile(features_list, log=print):
     import bpy
 
     from ..harness.engines import eevee_available
-    from .rt_lit_benchmark import _captured_output, _scene
+    from .rt_lit_benchmark import captured_output, lights_scene
 
     ok, _ = eevee_available()
     if not ok:
@@ -96,11 +96,11 @@ def eevee_compile(features_list, log=print):
     out = {}
     with tempfile.TemporaryDirectory(prefix="rtl-eevee-compile-") as tmp:
         for features in features_list:
-            _scene(features, 1)
+            lights_scene(features, 1)
             path = str(Path(tmp) / "scene.blend")
             bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
             bpy.ops.wm.open_mainfile(filepath=path)
-            with _captured_output():
+            with captured_output():
                 first = _render_seconds(bpy.context.scene, "BLENDER_EEVEE", BASE_RESOLUTION)
                 second = _render_seconds(bpy.context.scene, "BLENDER_EEVEE", BASE_RESOLUTION)
             out[features.label()] = {"first": first, "second": second, "compile": first - second}

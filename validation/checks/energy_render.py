@@ -37,14 +37,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import outputs
-
-
-
-from ...core import energy  # noqa: E402
+from ...core import energy
 from ...core import lut_bake as bake
-from ...core.lut import catalog  # noqa: E402
+from ...core.lut import catalog
 from ...core.lut.lookup import LutSet
+from ..harness import outputs, scene_render
 
 #: Bin edges in mu for the report; bins below MU_JUDGED are reported, not judged.
 MU_EDGES = tuple(float(x) for x in np.round(np.linspace(0.0, 1.0, 11), 10))
@@ -77,31 +74,11 @@ VIEW = np.array([0.0, 0.0, 1.0])  # direction towards the orthographic camera
 # scene
 # ---------------------------------------------------------------------------------------------
 
-def _bpy():
-    import bpy  # imported once per process by whoever calls us first; never re-imported
-
-    return bpy
-
-
-def _uv_sphere_mesh(bpy, name, segments, rings):
-    import bmesh
-
-    mesh = bpy.data.meshes.new(name)
-    bm = bmesh.new()
-    bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=SPHERE_RADIUS)
-    bm.to_mesh(mesh)
-    bm.free()
-    mesh.shade_smooth()
-    # Exactly radial vertex normals (the default ones are angle-weighted face averages, close
-    # to radial but not equal near the poles).
-    mesh.normals_split_custom_set_from_vertices([v.co.normalized() for v in mesh.vertices])
-    return mesh
-
-
 def build_scene(roughness, resolution, segments=256, rings=128):
     """Reset the file and build the spheres, world and camera.  Returns (scene, glossy nodes)."""
     from ...addon import compat
-    bpy = _bpy()
+    import bpy
+
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
     n = len(roughness)
@@ -116,7 +93,7 @@ def build_scene(roughness, resolution, segments=256, rings=128):
     wt.links.new(bg.outputs["Background"], wout.inputs["Surface"])
     scene.world = world
 
-    mesh = _uv_sphere_mesh(bpy, "RTL_sphere", segments, rings)
+    mesh = scene_render.uv_sphere_mesh("RTL_sphere", segments, rings, SPHERE_RADIUS)
     glossies = []
     for i, r in enumerate(roughness):
         mat = compat.new_material(f"RTL_glossy_{r:g}")
@@ -190,23 +167,6 @@ def configure_render(scene, samples, seed, threads=2):
     s = scene.render.image_settings
     compat.set_exr_output(s, multilayer=True)
     s.exr_codec = "ZIP"
-
-
-def render_exr(scene, path):
-    bpy = _bpy()
-    scene.render.filepath = str(path)
-    t0 = time.perf_counter()
-    bpy.ops.render.render(write_still=True)
-    return time.perf_counter() - t0
-
-
-def read_passes(path):
-    """(combined RGB, normal XYZ) float64 arrays (H, W, 3) from a multilayer EXR, all parts."""
-    from ..harness import exr_images
-
-    ch = exr_images.read_channels(path)
-    return (exr_images.find_pass(ch, "Combined", "RGB").astype(np.float64),
-            exr_images.find_pass(ch, "Normal", "XYZ").astype(np.float64))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -358,7 +318,7 @@ def analyse(renders, roughness, tables, exact=None, mu_edges=MU_EDGES, z_max=Z_M
 # driver
 # ---------------------------------------------------------------------------------------------
 
-def _tables(lut_dir):
+def energy_tables(lut_dir):
     """The LUT set of lut_dir, or of the shipped folder if current, or of a fresh temp bake."""
     if lut_dir is None:
         if all(s.state == "ok" for s in catalog.lut_status()):
@@ -381,7 +341,7 @@ def run(resolution=256, samples=256, roughness=(0.25, 0.5, 0.75, 1.0), out_dir=N
     exr_dir = out_dir if keep_exr else Path(tempfile.mkdtemp(prefix="rtl-energy-exr-"))
 
     t0 = time.perf_counter()
-    tables, lut_used = _tables(lut_dir)
+    tables, lut_used = energy_tables(lut_dir)
     t_luts = time.perf_counter() - t0
     t0 = time.perf_counter()
     exact_e = ExactE(roughness) if exact else None
@@ -399,9 +359,9 @@ def run(resolution=256, samples=256, roughness=(0.25, 0.5, 0.75, 1.0), out_dir=N
         for seed in seeds[:2]:
             configure_render(scene, samples, seed, threads)
             path = exr_dir / f"energy_{dist.lower()}_seed{seed}.exr"
-            timings[f"{dist}_seed{seed}"] = render_exr(scene, path)
+            timings[f"{dist}_seed{seed}"] = scene_render.render_exr(scene, path)
             log(f"[validate_energy] rendered {path.name} in {timings[f'{dist}_seed{seed}']:.1f} s")
-            pair.append(read_passes(path))
+            pair.append(scene_render.read_passes(path))
             if not keep_exr:
                 path.unlink()
         renders[dist] = pair
@@ -411,7 +371,8 @@ def run(resolution=256, samples=256, roughness=(0.25, 0.5, 0.75, 1.0), out_dir=N
     t0 = time.perf_counter()
     results = analyse(renders, roughness, tables, exact_e)
     t_analyse = time.perf_counter() - t0
-    bpy = _bpy()
+    import bpy
+
     results["settings"] = {
         "blender": bpy.app.version_string, "resolution_per_sphere": resolution,
         "image": [scene.render.resolution_x, scene.render.resolution_y], "samples": samples,

@@ -10,7 +10,7 @@
 and, where EEVEE can render, (d) the lookdev scene in EEVEE against (a).
 Per sphere (the Object Index pass; silhouette pixels, where a pixel centre may fall on either side of the
 edge, left out): the relative error of each channel where the reference is above 1% of that sphere's
-maximum, as the validation suite measures it (``suite._rel_values``): median and p90, and the reference's
+maximum, as the validation suite measures it (``harness.metrics.rel_values``): median and p90, and the reference's
 noise median.  The film is transparent for the measurement, so the world behind the spheres is not
 compared; the scenes' own settings are put back afterwards.
 """
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import exr_images
+from ..harness import exr_images, metrics
 
 #: Reference values below this fraction of the sphere's maximum are not compared (the suite's floor).
 FLOOR_FRACTION = 0.01
@@ -78,27 +78,8 @@ def render_measurement(scene, resolution, samples, seed, folder):
         seconds = time.perf_counter() - t0
     ch = exr_images.read_channels(exr)
     rgb = exr_images.find_pass(ch, "Combined", "RGB").astype(np.float64)
-    index = np.rint(_object_index(ch)[..., 0]).astype(int)
+    index = np.rint(exr_images.object_index_pass(ch)[..., 0]).astype(int)
     return rgb, index, seconds
-
-
-def _object_index(channels):
-    """The Object Index pass: "IndexOB" in the EXR of Blender 4.5, "Object Index" from 5.0 on (measured with
-    the pinned wheels)."""
-    try:
-        return exr_images.find_pass(channels, "Object Index", "X")
-    except KeyError:
-        return exr_images.find_pass(channels, "IndexOB", "X")
-
-
-def _interior(index):
-    """Pixels whose four neighbours show the same object (silhouettes left out)."""
-    keep = index > 0
-    for axis in (0, 1):
-        for shift in (1, -1):
-            keep &= np.roll(index, shift, axis=axis) == index
-    keep[0, :] = keep[-1, :] = keep[:, 0] = keep[:, -1] = False
-    return keep
 
 
 def _stats(rel):
@@ -111,16 +92,14 @@ def _stats(rel):
 def sphere_errors(a, reference_pair, index, names):
     """{name: {"values", "median", "p90", "mean", "noise_median"}} of ``a`` against the mean of the two
     references, per object index (1-based, ``names[i - 1]``), and "all" pooled."""
-    from .suite import _rel_values
-
     c = 0.5 * (reference_pair[0] + reference_pair[1])
-    interior = _interior(index)
+    interior = metrics.interior_pixels(index)
     out, pooled, noises = {}, [], []
     for i, name in enumerate(names, start=1):
         mask = interior & (index == i)
         if not mask.any():
             continue
-        rel, noise = _rel_values(a, c, mask, FLOOR_FRACTION, reference_pair)
+        rel, noise = metrics.rel_values(a, c, mask, FLOOR_FRACTION, reference_pair)
         out[name] = dict(_stats(rel), noise_median=float(np.median(noise)) if noise is not None and noise.size else None)
         if rel is not None:
             pooled.append(rel)
@@ -168,7 +147,7 @@ def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee
         result["without_shadows"] = sphere_errors(a, unshadowed, index, names)
         shadow_mean = 0.5 * (refs[0] + refs[1])
         free_mean = 0.5 * (unshadowed[0] + unshadowed[1])
-        sel = _interior(index) & (free_mean.max(axis=-1) > 0)
+        sel = metrics.interior_pixels(index) & (free_mean.max(axis=-1) > 0)
         darkened = (free_mean - shadow_mean).max(axis=-1)[sel] / np.maximum(free_mean.max(axis=-1)[sel], 1e-12)
         result["shadowed_fraction"] = float((darkened > 0.05).mean()) if darkened.size else 0.0
         result["seconds"] = {"rt_lit_cycles": t_a, "path_traced": float(np.median(times))}
@@ -196,7 +175,7 @@ def _eevee_against_cycles(scene, resolution, cycles, index, folder, log):
         finally:
             scene.world = world          # the EEVEE measurement swaps in a black world
     eevee = out["BLENDER_EEVEE"][0].astype(np.float64)
-    mask = _interior(index)
+    mask = metrics.interior_pixels(index)
     stats = compare_engines(cycles[mask], eevee[mask])
     stats.pop("argmax", None)
     stats["seconds"] = out["BLENDER_EEVEE"][1]
@@ -312,7 +291,7 @@ def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print):
 
 
 def _floor_mask(result, index):
-    return _interior(result["index"]) & (result["index"] == index)
+    return metrics.interior_pixels(result["index"]) & (result["index"] == index)
 
 
 def run(out_dir, lut_dir=None, resolution=(320, 160), samples=256, eevee=True, pictures_dir=None, log=print):

@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from ...core import rough_diffuse
+from ..harness import outputs, scene_render
 from . import energy_render
-from ..harness import outputs
 
 #: (label, node, rho, sigma): the spheres, left to right.
 DEFAULT_CASES = (
@@ -77,7 +77,8 @@ def _set_material(bpy, material, node, rho, sigma):
 
 def build_scene(cases, resolution):
     """``energy_render``'s spheres and world, each sphere's material replaced by its case's BSDF."""
-    bpy = energy_render._bpy()
+    import bpy
+
     scene, _ = energy_render.build_scene([1.0] * len(cases), resolution, segments=128, rings=64)
     for i, (_, node, rho, sigma) in enumerate(cases):
         _set_material(bpy, bpy.data.objects[f"RTL_sphere_{i}"].material_slots[0].material, node, rho, sigma)
@@ -118,6 +119,8 @@ def analyse(renders, cases, mu_edges=MU_EDGES):
 
 def run(cases=DEFAULT_CASES, resolution=96, samples=64, seeds=(0, 1), threads=2, out_dir=None, log=print):
     """Render the furnace pair and analyse it; returns a JSON-serialisable dict (also written to out_dir)."""
+    import bpy
+
     t0 = time.perf_counter()
     out_dir = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="rtl-rough-diffuse-"))
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -127,9 +130,8 @@ def run(cases=DEFAULT_CASES, resolution=96, samples=64, seeds=(0, 1), threads=2,
         energy_render.configure_render(scene, samples, seed, threads)
         scene.cycles.diffuse_bounces = 1          # the world is reached by one diffuse bounce (MIS with its light)
         path = out_dir / f"rough_diffuse_furnace_seed{seed}.exr"
-        energy_render.render_exr(scene, path)
-        renders.append(energy_render.read_passes(path))
-    bpy = energy_render._bpy()
+        scene_render.render_exr(scene, path)
+        renders.append(scene_render.read_passes(path))
     res = {"blender": bpy.app.version_string, "resolution_per_sphere": resolution, "samples": samples,
            "seeds": list(seeds[:2]), "cases": analyse(renders, cases), "seconds": time.perf_counter() - t0}
     (out_dir / "rough_diffuse_furnace.json").write_text(json.dumps(res, indent=2, default=outputs.json_default))

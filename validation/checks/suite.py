@@ -66,7 +66,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import outputs
+from ..harness import metrics, outputs, scene_render
 from . import suite_cases as suite, suite_html
 
 DEFAULTS = {"ab_tol": 1e-4, "ab_atol": 1e-6, "lambert_median": 0.005, "ggx_quad_median": 0.02,
@@ -76,37 +76,6 @@ DEFAULTS = {"ab_tol": 1e-4, "ab_atol": 1e-6, "lambert_median": 0.005, "ggx_quad_
 BRUTE_CHECK = ("lambert", "ggx", "turquin", "metal")
 BRUTE_CHECK_PIXELS = 40
 ERR_VMAX = 0.2
-
-
-def _pool(entries):
-    rel = np.concatenate([e["rel"] for e in entries]) if entries else np.zeros(0)
-    out = {"values": int(rel.size)}
-    if rel.size:
-        out.update({"mean": float(rel.mean()), "median": float(np.median(rel)),
-                    "p90": float(np.percentile(rel, 90)), "max": float(rel.max())})
-    noise = [e["noise"] for e in entries if e.get("noise") is not None and e["noise"].size]
-    if noise:
-        out["noise_median"] = float(np.median(np.concatenate(noise)))
-        out["noise_p90"] = float(np.percentile(np.concatenate(noise), 90))
-    wide = [e["rel_wide"] for e in entries if e.get("rel_wide") is not None]
-    if wide:
-        w = np.concatenate(wide)
-        out.update({"wide_median": float(np.median(w)), "wide_p90": float(np.percentile(w, 90))})
-    return out
-
-
-def _rel_values(a, c, mask, floor_frac, c_pair=None):
-    av, cv = a[mask].astype(np.float64).ravel(), c[mask].astype(np.float64).ravel()
-    ok = np.isfinite(cv)
-    if not ok.any():
-        return None, None
-    sel = ok & (cv > floor_frac * cv[ok].max())
-    rel = np.abs(av[sel] - cv[sel]) / cv[sel]
-    noise = None
-    if c_pair is not None:
-        c1, c2 = (x[mask].astype(np.float64).ravel()[sel] for x in c_pair)
-        noise = np.abs(c1 - c2) / 2.0 / cv[sel]
-    return rel, noise
 
 
 def case_samples(case, args):
@@ -200,8 +169,8 @@ def _variant_entries(case, args, a, b, index, t):
         if t["check"] is not None and i in t["check_idx"]:
             entry["brute_check"] = suite.truth_metrics(c, t["check"], mask, args.floor)   # Cycles vs brute force
             entry["brute_check_seconds"] = t["t_check"].get(i)
-        rel, noise = _rel_values(a, c, mask, args.floor, cp)
-        rel_w, _ = _rel_values(a, c, mask, args.floor_wide, cp)
+        rel, noise = metrics.rel_values(a, c, mask, args.floor, cp)
+        rel_w, _ = metrics.rel_values(a, c, mask, args.floor_wide, cp)
         if rel is not None and rel.size:
             pooled_parts.append({"technique": v.technique, "light": "+".join(case.light_kinds), "truth": v.truth,
                                  "rel": rel, "noise": noise, "rel_wide": rel_w})
@@ -282,7 +251,7 @@ def run_furnace(args, out_dir, log=print):
     ms = {k: {"mean": v["mean"], "se": v["se"], "ok": v["ok"]} for k, v in energy["MULTI_GGX"].items()}
     ms_ok = all(abs(v["mean"] - 1.0) <= args.furnace_tol for v in ms.values())
 
-    tables, _ = ve._tables(args.lut_dir)
+    tables, _ = ve.energy_tables(args.lut_dir)
     mu = np.linspace(0.1, 1.0, 10)
     t0 = time.perf_counter()
     kc = core_validation.kulla_conty_furnace(tables, np.array(roughness), mu)
@@ -301,8 +270,8 @@ def run_furnace(args, out_dir, log=print):
     for seed in args.seeds[:2]:
         ve.configure_render(scene, args.furnace_samples, seed, args.threads)
         path = folder / f"kc_color_seed{seed}.exr"
-        ve.render_exr(scene, path)
-        pair.append(ve.read_passes(path))
+        scene_render.render_exr(scene, path)
+        pair.append(scene_render.read_passes(path))
     (ca, na), (cb, nb) = pair
     h, w = ca.shape[:2]
     sphere, _ = ve.pixel_geometry(w, h, len(roughness))
@@ -551,12 +520,12 @@ def run(args, log=print):
     for p in pooled_parts:
         for light in p["light"].split("+"):
             groups.setdefault((p["technique"], light, p["truth"]), []).append(p)
-    pooled = [dict(technique=t, light=l, truth=tr, **_pool(e)) for (t, l, tr), e in sorted(groups.items())]
+    pooled = [dict(technique=t, light=l, truth=tr, **metrics.pool(e)) for (t, l, tr), e in sorted(groups.items())]
     by_light = {}
     for p in pooled_parts:
         for light in p["light"].split("+"):
             by_light.setdefault(light, []).append(p)
-    pooled_by_light = [dict(light=light, **_pool(e)) for light, e in sorted(by_light.items())]
+    pooled_by_light = [dict(light=light, **metrics.pool(e)) for light, e in sorted(by_light.items())]
     checks = _checks(args, results, pooled, furnace) + light_model_checks(pooled_by_light)
     import bpy
 

@@ -24,7 +24,7 @@ set of Blender lights, seen by an orthographic camera looking along +Y.  Per cas
 
 Spheres are seen by camera rays only (no sphere shadows or lights another), so a sphere is convex
 and unoccluded; their meshes are 192 x 96 UV spheres with exactly radial normals
-(validate_energy's mesh).  The RT Lit material's specular is switched off for pure-diffuse variants
+(harness/scene_render.py's mesh).  The RT Lit material's specular is switched off for pure-diffuse variants
 by Cloth Weight 1 with a black Cloth Color (RT Lit has no "no specular" switch; spec x (1 - w) +
 cloth x w = 0), and its diffuse by Metallic 1 (albedo 0).
 """
@@ -39,8 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-
 from ...core.materials.rt_lit_interface import Features
+from ..harness import closures, scene_render
 
 # --- case description -----------------------------------------------------------------------
 
@@ -530,7 +530,6 @@ def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
     from ...addon import compat
     import bpy
 
-    from . import energy_render as validate_energy
     from ...addon import materials
 
     bpy.ops.wm.read_homefile(use_empty=True)
@@ -543,7 +542,7 @@ def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
     materials.sync_scene_lights(scene)
 
     centres, cols, rows = sphere_centres(case)
-    mesh = validate_energy._uv_sphere_mesh(bpy, "RTL_val_sphere", segments, rings)
+    mesh = scene_render.uv_sphere_mesh("RTL_val_sphere", segments, rings)
     spheres = []
     for i, (variant, centre) in enumerate(zip(case.variants, centres)):
         me = mesh.copy()
@@ -671,86 +670,6 @@ def conditioning(fn, passes, b=None):
 
 # --- (c) Cycles ground truth -----------------------------------------------------------------
 
-def _closure_material(variant, name):
-    from ...addon import compat
-
-    mat = compat.new_material(name)
-    nt = mat.node_tree
-    nt.nodes.clear()
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    m = variant.material()
-    t = variant.technique
-
-    def glossy(dist):
-        g = nt.nodes.new("ShaderNodeBsdfGlossy")
-        g.distribution = dist
-        g.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-        g.inputs["Roughness"].default_value = m["Roughness"]
-        g.inputs["Anisotropy"].default_value = 0.0
-        return g
-
-    def metallic(f0, dist="GGX"):
-        g = nt.nodes.new("ShaderNodeBsdfMetallic")
-        g.distribution = dist
-        g.fresnel_type = "F82"
-        g.inputs["Base Color"].default_value = tuple(f0) + (1.0,)
-        g.inputs["Edge Tint"].default_value = (1.0, 1.0, 1.0, 1.0)
-        g.inputs["Roughness"].default_value = m["Roughness"]
-        g.inputs["Anisotropy"].default_value = 0.0
-        return g
-
-    def diffuse(color):
-        d = nt.nodes.new("ShaderNodeBsdfDiffuse")
-        d.inputs["Color"].default_value = tuple(color) + (1.0,)
-        d.inputs["Roughness"].default_value = 0.0
-        return d
-
-    if t == "lambert":
-        shader = diffuse(m["Base Color"])
-    elif t in ("oren_nayar", "cod_cycles"):
-        shader = diffuse(m["Base Color"])
-        shader.inputs["Roughness"].default_value = m["Diffuse Roughness"]
-    elif t == "ggx":
-        shader = glossy("GGX")
-    elif t in ("turquin", "fdez_aguera", "kulla_conty_white"):
-        shader = glossy("MULTI_GGX")
-    elif t == "metal":
-        shader = metallic(m["Base Color"])
-    elif t == "zeltner":
-        shader = nt.nodes.new("ShaderNodeBsdfSheen")
-        shader.distribution = "MICROFIBER"
-        shader.inputs["Color"].default_value = tuple(np.multiply(m["Sheen Tint"], m["Sheen Weight"])) + (1.0,)
-        shader.inputs["Roughness"].default_value = m["Sheen Roughness"]
-    elif t == "zeltner_principled":
-        shader = nt.nodes.new("ShaderNodeBsdfPrincipled")
-        values = {"Base Color": tuple(m["Base Color"]) + (1.0,), "Metallic": 0.0, "Specular IOR Level": 0.0,
-                  "Sheen Weight": m["Sheen Weight"], "Sheen Roughness": m["Sheen Roughness"],
-                  "Sheen Tint": tuple(m["Sheen Tint"]) + (1.0,), "Coat Weight": 0.0, "Transmission Weight": 0.0,
-                  "Subsurface Weight": 0.0, "Diffuse Roughness": 0.0}
-        for name, value in values.items():
-            if name in shader.inputs:              # Diffuse Roughness: Blender 4.3+
-                shader.inputs[name].default_value = value
-    elif t == "dielectric" or t.startswith("mix_"):
-        from ...core.materials.surface import dielectric_f0
-
-        dist = "MULTI_GGX" if t.startswith("mix_") else "GGX"
-        f0 = float(dielectric_f0(np.float64(m["IOR"]), np.float64(m["Specular IOR Level"])))
-        add = nt.nodes.new("ShaderNodeAddShader")
-        nt.links.new(metallic((f0, f0, f0), dist).outputs[0], add.inputs[0])
-        nt.links.new(diffuse(m["Base Color"]).outputs[0], add.inputs[1])
-        shader = add
-        if t.startswith("mix_"):
-            mix = nt.nodes.new("ShaderNodeMixShader")
-            mix.inputs["Fac"].default_value = m["Metallic"]
-            nt.links.new(add.outputs[0], mix.inputs[1])
-            nt.links.new(metallic(m["Base Color"], dist).outputs[0], mix.inputs[2])
-            shader = mix
-    else:
-        raise ValueError(f"{t} has no Cycles closure")
-    nt.links.new(shader.outputs[0], out.inputs["Surface"])
-    return mat
-
-
 def configure_truth_render(scene, samples, seed, threads=2):
     from ...addon import compat
     from ..harness.render_setup import configure_cycles_measurement
@@ -773,8 +692,6 @@ def configure_truth_render(scene, samples, seed, threads=2):
 def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
     """(c) for the Cycles-closure variants: one render per seed.  Returns ([rgb per seed], seconds
     per seed, normal) or None when no variant uses Cycles."""
-    from . import energy_render as validate_energy
-
     todo = [i for i, v in enumerate(case.variants) if v.truth == "cycles"]
     if not todo:
         return None
@@ -782,7 +699,7 @@ def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
     for i, ob in enumerate(spheres):
         saved.append((ob.data.materials[0], ob.hide_render))
         if i in todo:
-            ob.data.materials[0] = _closure_material(case.variants[i], f"RTL_truth_{i}")
+            ob.data.materials[0] = closures.closure_material(case.variants[i], f"RTL_truth_{i}")
         else:
             ob.hide_render = True
     images, seconds, normal = [], [], None
@@ -790,8 +707,8 @@ def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
         for seed in seeds:
             configure_truth_render(scene, samples, seed, threads)
             path = Path(folder) / f"truth_seed{seed}.exr"
-            seconds.append(validate_energy.render_exr(scene, path))
-            rgb, nrm = validate_energy.read_passes(path)
+            seconds.append(scene_render.render_exr(scene, path))
+            rgb, nrm = scene_render.read_passes(path)
             images.append(rgb)
             normal = nrm
     finally:
@@ -844,7 +761,7 @@ def _direction_weight(kind, params, position, dirs, light_normal):
     return weight
 
 
-def _rule(kind, geo, p, clip_normal, panels, order):
+def quadrature_rule(kind, geo, p, clip_normal, panels, order):
     """Points relative to p (M, 3), area weights (M,), unit light normal, or None if unlit."""
     from ...core.ltc import reference
 
@@ -921,7 +838,7 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
                         owner, dirs, irr = [], [], []
                         for k in range(start, min(start + chunk, len(ys))):
                             light = _area_geometry(kind, params, P[k]) if facing else geo
-                            rule = _rule(form, light, P[k], None if unclipped else N[k], level, order)
+                            rule = quadrature_rule(form, light, P[k], None if unclipped else N[k], level, order)
                             if rule is None or len(rule[1]) == 0:
                                 continue
                             xr, w, ln = rule

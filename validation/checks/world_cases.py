@@ -43,6 +43,8 @@ import numpy as np
 
 
 from ...core.materials.rt_lit_interface import Features
+from ..harness import closures, scene_render
+from . import suite_cases
 from .suite_cases import Variant
 
 CELL = 2.2                          # world units per sphere cell (suite_cases.CELL)
@@ -282,12 +284,10 @@ def _sphere(mesh, name, location, material):
 def closure_material(closure, name):
     """Cycles closure material of a truth sphere: ("DIFFUSE", 0) white Diffuse BSDF (roughness 0 =
     Lambert), ("GGX" | "MULTI_GGX", r) white Glossy BSDF (F = 1)."""
-    from . import suite_cases as suite
-
     kind, r = closure
     technique = {"DIFFUSE": "lambert", "GGX": "ggx", "MULTI_GGX": "turquin", "ROUGH_DIFFUSE": "oren_nayar", "SHEEN": "zeltner"}[kind]
-    color = suite.WHITE if kind == "ROUGH_DIFFUSE" else None        # white, as the node block's variants
-    return suite._closure_material(suite.Variant(technique, r, color), name)
+    color = suite_cases.WHITE if kind == "ROUGH_DIFFUSE" else None        # white, as the node block's variants
+    return closures.closure_material(Variant(technique, r, color), name)
 
 
 def new_scene():
@@ -308,10 +308,8 @@ def new_scene():
 def sphere_mesh(segments=192, rings=96):
     import bpy
 
-    from . import energy_render as validate_energy
-
     existing = bpy.data.meshes.get("RTL_valw_sphere")
-    return existing or validate_energy._uv_sphere_mesh(bpy, "RTL_valw_sphere", segments, rings)
+    return existing or scene_render.uv_sphere_mesh("RTL_valw_sphere", segments, rings)
 
 
 def add_node_block(scene, variants, cell_px, columns, z0=0.0, lut_dir=None, mesh=None, name="node"):
@@ -377,17 +375,13 @@ def render_node(scene, block, blocks, folder):
 def render_truth(scene, block, blocks, samples, seeds, folder, threads=2):
     """(c): the closure block rendered with Cycles path tracing, direct light only, once per seed.
     Returns ([rgb per seed], [seconds per seed], normal)."""
-    from . import energy_render as validate_energy
-
-    from . import suite_cases as suite
-
     frame(scene, block, blocks)
     images, seconds, normal = [], [], None
     for seed in seeds:
-        suite.configure_truth_render(scene, samples, seed, threads)
+        suite_cases.configure_truth_render(scene, samples, seed, threads)
         path = Path(folder) / f"truth_seed{seed}.exr"
-        seconds.append(validate_energy.render_exr(scene, path))
-        rgb, nrm = validate_energy.read_passes(path)
+        seconds.append(scene_render.render_exr(scene, path))
+        rgb, nrm = scene_render.read_passes(path)
         images.append(rgb)
         normal = nrm
     return images, seconds, normal
@@ -511,7 +505,7 @@ def cell_alignment(block_a, normal_a, i, block_c, normal_c, j):
 
 def max_fraction(c, mask, floor_frac):
     """The floor ``floor_frac`` x median(c) over the mask's values, as a fraction of their max (what
-    suite_cases.truth_metrics and suite._rel_values take).  Under an environment the max is a
+    suite_cases.truth_metrics and metrics.rel_values take).  Under an environment the max is a
     sun's highlight, hundreds of times the typical value, so a max-relative floor would keep only the
     highlight; the median-relative floor keeps every value but the nearly black ones."""
     cv = np.asarray(c, np.float64)[mask].ravel()

@@ -61,7 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..harness import outputs
+from ..harness import metrics, outputs
 from . import suite_cases as suite
 from . import world_cases as vw
 
@@ -77,17 +77,9 @@ ERR_VMAX = 0.2
 FRONT_MU = 0.5
 
 
-def _rel_values(a, c, mask, floor_frac, c_pair=None):
-    from . import suite as validate
-
-    return validate._rel_values(a, c, mask, floor_frac, c_pair)
-
-
 def _pool(entries):
-    """validate._pool plus the median / p90 over the front-facing values (N.V >= FRONT_MU)."""
-    from . import suite as validate
-
-    out = validate._pool(entries)
+    """``metrics.pool`` plus the median / p90 over the front-facing values (N.V >= FRONT_MU)."""
+    out = metrics.pool(entries)
     front = [e["rel_front"] for e in entries if e.get("rel_front") is not None]
     if front:
         f = np.concatenate(front)
@@ -402,8 +394,8 @@ def _variant_entries(spec, variants, ws, nr, truth, args):
              "closure": list(v.closure) if v.closure else None, "pixels": int(mask.sum()),
              "ab": suite.ab_metrics(nr.a, nr.b, mask)}
         if truth is not None and v.closure is not None:
-            m, c_cell, metrics, part = _truth_comparison(spec, i, v, ws, nr, truth, mu_img, samples_total, args)
-            e.update(metrics)
+            m, c_cell, figures, part = _truth_comparison(spec, i, v, ws, nr, truth, mu_img, samples_total, args)
+            e.update(figures)
             if part is not None:
                 parts.append(part)
             ws.nb.cell(c_full, i)[m] = c_cell[m]
@@ -424,22 +416,22 @@ def _truth_comparison(spec, i, v, ws, nr, truth, mu_img, samples_total, args):
     pair = pair if len(pair) > 1 else None
     frac = vw.max_fraction(c_cell, m, args.floor)
     frac_w = vw.max_fraction(c_cell, m, args.floor_wide)
-    metrics = {"cell_normal_max_diff": ndiff,
+    figures = {"cell_normal_max_diff": ndiff,
                "truth_metrics": suite.truth_metrics(a_cell, c_cell, m, frac, pair, samples_total,
                                                     error_exponent=suite.CYCLES_WORLD_ERROR_EXPONENT),
                "truth_metrics_wide": suite.truth_metrics(a_cell, c_cell, m, frac_w, pair, samples_total,
                                                          error_exponent=suite.CYCLES_WORLD_ERROR_EXPONENT)}
-    rel, noise = _rel_values(a_cell, c_cell, m, frac, pair)
-    rel_w, _ = _rel_values(a_cell, c_cell, m, frac_w)
+    rel, noise = metrics.rel_values(a_cell, c_cell, m, frac, pair)
+    rel_w, _ = metrics.rel_values(a_cell, c_cell, m, frac_w)
     rel_f = _front_rel_values(a_cell, c_cell, m, ws.nb.cell(mu_img, i), frac)
     if rel_f is not None:
-        metrics["truth_metrics_front"] = {"values": int(rel_f.size), "median": float(np.median(rel_f)),
+        figures["truth_metrics_front"] = {"values": int(rel_f.size), "median": float(np.median(rel_f)),
                                           "p90": float(np.percentile(rel_f, 90)), "mean": float(rel_f.mean())}
     part = None
     if rel is not None:
         part = {"technique": v.technique, "roughness": v.roughness, "world": spec.name,
                 "rel": rel, "noise": noise, "rel_wide": rel_w, "rel_front": rel_f}
-    return m, c_cell, metrics, part
+    return m, c_cell, figures, part
 
 
 def _front_rel_values(a_cell, c_cell, m, mu_cell, frac):
@@ -450,7 +442,7 @@ def _front_rel_values(a_cell, c_cell, m, mu_cell, frac):
     # the same absolute floor as the whole sphere's
     cmax_f = float(np.nanmax(c_cell[front]))
     frac_f = frac * float(np.nanmax(c_cell[m])) / cmax_f if cmax_f > 0 else frac
-    rel_f, _ = _rel_values(a_cell, c_cell, front, frac_f)
+    rel_f, _ = metrics.rel_values(a_cell, c_cell, front, frac_f)
     return rel_f
 
 

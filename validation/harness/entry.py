@@ -52,7 +52,4 @@ def main(module, argv, progress=flush_log):
 def run_tasks(run_task, tasks, args, progress=flush_log, **shared):
     """``run_task(task, args, **shared)`` for every task, in order, here: the records.  The one place a sweep's
     cases are mapped; running them elsewhere (worker processes, a cluster) replaces this map."""
-    records = []
-    for i, task in enumerate(tasks):
-        records.append(run_task(task, args, progress=progress, **shared))
-    return records
+    return [run_task(task, args, progress=progress, **shared) for task in tasks]

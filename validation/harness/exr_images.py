@@ -67,3 +67,12 @@ def write_rgb(path, rgb):
     with exr.File(header, {"RGB": np.ascontiguousarray(rgb)}) as f:
         f.write(str(path))
     return Path(path)
+
+
+def object_index_pass(channels):
+    """The Object Index pass: "IndexOB" in the EXR of Blender 4.5, "Object Index" from 5.0 on (measured with
+    the pinned wheels)."""
+    try:
+        return find_pass(channels, "Object Index", "X")
+    except KeyError:
+        return find_pass(channels, "IndexOB", "X")
