@@ -261,10 +261,11 @@ def step_render(out_dir, lut_dir, resolution, samples, log=entry.flush_log):
 def step_ltc(lut_dir, log=entry.flush_log):
     log("[3/13] LTC area lights: random quads and disks vs brute force")
     from .benchmarks import ltc_benchmark as benchmark_ltc
+    from .benchmarks import ltc_random_lights
 
     t0 = time.perf_counter()
     tables = {name: benchmark_ltc.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}
-    results = benchmark_ltc.end_to_end(tables, None, *LTC_LIGHTS)
+    results = ltc_random_lights.end_to_end(tables, None, *LTC_LIGHTS)
     out = {"lights_per_brdf": {"quads": LTC_LIGHTS[0], "disks": LTC_LIGHTS[1]}, "results": results,
            "seconds": round(time.perf_counter() - t0, 1)}
     out["passed"] = all(results[f"{lobe}/quad"]["ours"]["rel_median"] <= tol for lobe, tol in LTC_MEDIAN_TOL.items())

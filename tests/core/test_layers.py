@@ -6,6 +6,8 @@
   none of them;
 - no import cycle among the project's modules (imports inside functions count);
 - no private name (a leading underscore) crosses a module: ``from x import _y`` or ``x._y`` on an imported module;
+- every attribute taken from an imported project module exists there (what a moved function leaves behind);
+- no file in validation/ is over 600 lines;
 - no module of core/ imports bpy (or any other Blender module);
 - no sys.path edits in scripts/ or tests/ (the package is installed in editable mode: pyproject.toml);
 - every file name is used once in the tree;
@@ -14,6 +16,7 @@
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from pathlib import Path
 
@@ -304,3 +307,75 @@ def test_the_private_name_rule_catches_one():
     assert not private_names_across_modules(path)
     assert private_names_across_modules(path, path.read_text() + "\nfrom .suite_cases import _x\n")
     assert private_names_across_modules(path, path.read_text() + "\ny = outputs._fmt_csv\n")
+
+
+VALIDATION_MAX_LINES = 600
+
+
+def test_validation_files_are_at_most_600_lines():
+    """A validation module that grows past this is split by concern (scenes, renders, metrics, report, driver)."""
+    long = {str(p.relative_to(REPO)): n for p in sorted((REPO / "validation").rglob("*.py"))
+            if (n := len(p.read_text().splitlines())) > VALIDATION_MAX_LINES}
+    assert not long, long
+
+
+@functools.lru_cache(maxsize=None)
+def _top_level_names(module):
+    """The names a project module defines or imports at its top level (and, for a package, its submodules)."""
+    base = REPO.joinpath(*module.split("."))
+    path = base.with_suffix(".py") if base.with_suffix(".py").is_file() else base / "__init__.py"
+    tree = ast.parse(path.read_text(), str(path))
+    names = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            names.update(a.asname or a.name.split(".")[0] for a in node.names)
+        else:
+            for sub in ast.walk(node):
+                if isinstance(sub, ast.Name) and isinstance(sub.ctx, ast.Store):
+                    names.add(sub.id)
+                elif isinstance(sub, (ast.FunctionDef, ast.ClassDef)):
+                    names.add(sub.name)
+    if path.name == "__init__.py":
+        names.update(p.stem for p in path.parent.glob("*.py"))
+        names.update(p.name for p in path.parent.iterdir() if p.is_dir())
+    return names
+
+
+def missing_module_attributes(path):
+    """``m.name`` where ``m`` is an imported project module that has no ``name`` (a function moved away, a
+    misspelling): what a refactoring leaves behind and only a run would find.  Names also bound locally (a
+    parameter or variable shadowing the module) are not judged."""
+    tree = ast.parse(path.read_text(), str(path))
+    in_package = path.relative_to(REPO).parts[0] in PACKAGES
+    me = _module_name(path) if in_package else ""
+    package = (me.split(".") if path.name == "__init__.py" else me.split(".")[:-1]) if in_package else []
+    modules = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level and in_package:
+                base = package[:len(package) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            elif not node.level and node.module and node.module.split(".")[0] == "rt_lookdev":
+                target = node.module.removeprefix("rt_lookdev").lstrip(".")
+            else:
+                continue
+            for alias in node.names:
+                sub = f"{target}.{alias.name}" if target else alias.name
+                if _is_module(sub):
+                    modules[alias.asname or alias.name] = sub
+        elif isinstance(node, ast.Import):
+            modules.update({a.asname: a.name.removeprefix("rt_lookdev.") for a in node.names
+                            if a.name.startswith("rt_lookdev.") and a.asname})
+    bound = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)}
+    bound |= {n.arg for n in ast.walk(tree) if isinstance(n, ast.arg)}
+    return [f"{path.relative_to(REPO)}:{n.lineno} {n.value.id}.{n.attr}" for n in ast.walk(tree)
+            if isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name) and n.value.id in modules
+            and n.value.id not in bound and n.attr not in _top_level_names(modules[n.value.id])]
+
+
+def test_attributes_taken_from_project_modules_exist():
+    paths = project_modules() + sorted((REPO / "scripts").glob("*.py")) + sorted((REPO / "tests").rglob("*.py"))
+    missing = [line for path in paths for line in missing_module_attributes(path)]
+    assert not missing, "attributes that the imported module lacks:\n  " + "\n  ".join(missing)

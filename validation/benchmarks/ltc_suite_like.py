@@ -10,7 +10,7 @@ the error can be reported per roughness band and per light kind.
 
 - Geometry: ``suite_cases.build_cases()`` (full set): each area light (quads 0-3, disks 4-6, the two sweeps'
   lights) with the sphere centres of its case; the light's frame as Blender's track-to constraint gives it
-  (``suite_cases._aim``: local -Z towards the target, local +Y towards world +Z); view direction -Y (the
+  (``suite_scene._aim``: local -Z towards the target, local +Y towards world +Z); view direction -Y (the
   orthographic camera); shading points at the pixel centres of a grid of ``cell`` pixels per sphere cell (the
   suite renders 64; 24 by default), off the silhouette's last 1%.
 - Values: LTC magnitude x integral (the lobe's radiance per unit light radiance, F0 = 1) against the brute
@@ -29,6 +29,7 @@ import numpy as np
 from ...core.ltc import fit_lobes, shading
 from ...core.lut import catalog, lookup
 from ..checks import suite_cases
+from ..checks import suite_brute_force
 
 #: Roughness values measured at every sphere.
 ROUGHNESS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
@@ -38,7 +39,7 @@ FLOOR = 0.1
 
 
 def _track_frame(location, target):
-    """Local X, Y, Z axes of an object aimed with ``to_track_quat("-Z", "Y")`` (``suite_cases._aim``): -Z
+    """Local X, Y, Z axes of an object aimed with ``to_track_quat("-Z", "Y")`` (``suite_scene._aim``): -Z
     along the direction to the target, +Y as close to world +Z as the track allows."""
     d = np.asarray(target, np.float64) - np.asarray(location, np.float64)
     z = -d / np.linalg.norm(d)
@@ -97,7 +98,7 @@ def build_set(seed=0, cell=24, pixels=None):
     return out
 
 
-VIEW = np.array([0.0, -1.0, 0.0])      # towards the orthographic camera (suite_cases.build_scene)
+VIEW = np.array([0.0, -1.0, 0.0])      # towards the orthographic camera (suite_scene.build_scene)
 
 
 def _local(frame, d):
@@ -107,10 +108,10 @@ def _local(frame, d):
 
 def _rule(light, p, n, panels, order):
     """Unit directions from p and solid-angle weights of the light clipped at the horizon of normal n (the suite's
-    brute-force rule, ``suite_cases.quadrature_rule``), or None."""
+    brute-force rule, ``suite_brute_force.quadrature_rule``), or None."""
     geo = ({"corners": light["corners"]} if light["kind"] == "quad"
            else {"center": light["center"], "u": light["axis_u"], "v": light["axis_v"]})
-    rule = suite_cases.quadrature_rule(light["kind"], geo, p, n, panels, order)
+    rule = suite_brute_force.quadrature_rule(light["kind"], geo, p, n, panels, order)
     if rule is None or len(rule[1]) == 0:
         return None
     x, w, normal = rule

@@ -7,7 +7,7 @@ For the tables of the rtl layout (core/export/luts.py), three variants: float32 
 #20477 is that failure), and half as the exporter stores it (channels with values below half's smallest
 normal multiplied by a power of two, decoded after the lookup).  Measured:
 - per table: max absolute and relative error against float32, values that lose more than 2^-11;
-- end to end: the LTC benchmark's seeded quads and disks per BRDF (validation/benchmarks/ltc_benchmark.end_to_end,
+- end to end: the LTC benchmark's seeded quads and disks per BRDF (validation/benchmarks/ltc_random_lights.end_to_end,
   the main job's light set by default) against brute force, for each variant;
 - energy compensation: Kulla-Conty's furnace E_ss + E_ms - 1 over r in [0, 1], mu >= 0.1 (the lobe reads
   1 - E and 1 - E_avg), and how far Turquin's 1 + (1 - E)/E and Fdez-Aguera's E_ss + E_ms (F0 = 0.04) move
@@ -27,7 +27,7 @@ from ...core.export import luts
 from ...core.ir.tables import Table
 from ...core.lut import catalog
 from ...core.lut.lookup import LutSet
-from . import ltc_benchmark
+from . import ltc_random_lights
 from ..harness import entry
 
 REPO = Path(__file__).resolve().parents[2]
@@ -77,7 +77,7 @@ def run(args, log=entry.flush_log):
     for variant, arrays in variants.items():
         log(f"[lut export] {variant}: LTC light set, furnaces")
         ltc = {n: a for n, a in arrays.items() if n.startswith("ltc_")}
-        result["end_to_end"][variant] = ltc_benchmark.end_to_end(ltc, None, args.quads, args.disks)
+        result["end_to_end"][variant] = ltc_random_lights.end_to_end(ltc, None, args.quads, args.disks)
         result["furnaces"][variant] = furnaces(arrays, variants["f32"])
     result["seconds"] = time.perf_counter() - t0
     out = Path(args.out)

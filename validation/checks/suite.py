@@ -68,6 +68,9 @@ import numpy as np
 
 from ..harness import metrics, outputs, scene_render
 from . import suite_cases as suite, suite_html
+from . import suite_brute_force
+from . import suite_metrics
+from . import suite_scene
 
 DEFAULTS = {"ab_tol": 1e-4, "ab_atol": 1e-6, "lambert_median": 0.005, "ggx_quad_median": 0.02,
             "ggx_quad_p90": 0.12, "furnace_tol": 0.005, "floor": 0.1, "floor_wide": 0.01}
@@ -94,12 +97,12 @@ def _render_case(case, args, folder):
     from ..harness.engines import render_cycles_passes
 
     t0 = time.perf_counter()
-    scene, spheres = suite.build_scene(case, args.cell, args.segments, args.segments // 2, args.lut_dir)
+    scene, spheres = suite_scene.build_scene(case, args.cell, args.segments, args.segments // 2, args.lut_dir)
     t_build = time.perf_counter() - t0
     res = (scene.render.resolution_x, scene.render.resolution_y)
     passes = render_cycles_passes(scene, res, path=folder)
     a = passes["Combined"].astype(np.float64)
-    index = suite.sphere_index(case, passes["Position"], passes["Normal"])
+    index = suite_scene.sphere_index(case, passes["Position"], passes["Normal"])
     return scene, spheres, res, passes, a, index, t_build
 
 
@@ -110,11 +113,11 @@ def _numpy_case(case, scene, passes, index, tables):
     objects = [scene.objects[f"RTL_val_sphere_{i}"] for i in range(len(case.variants))]
 
     def fn(p, dtype):
-        return suite.numpy_radiance(scene, case.variants, objects, p, index, tables, None, dtype)
+        return suite_scene.numpy_radiance(scene, case.variants, objects, p, index, tables, None, dtype)
 
     b = fn(passes, np.float32)
     t_b = time.perf_counter() - t0
-    _, conditioning = suite.conditioning(fn, passes, b)
+    _, conditioning = suite_scene.conditioning(fn, passes, b)
     return b, t_b, conditioning
 
 
@@ -123,7 +126,7 @@ def _truth_case(case, args, scene, spheres, passes, index, folder, rng, tables, 
     brute-force check on a few Cycles-truth pixels.  Returns a dict: c, samples, truth, pair, qerr,
     t_brute, check, check_idx, t_check."""
     samples = case_samples(case, args)
-    truth = suite.render_truth(case, scene, spheres, samples, tuple(args.seeds), folder, args.threads)
+    truth = suite_scene.render_truth(case, scene, spheres, samples, tuple(args.seeds), folder, args.threads)
     c = np.full(shape, np.nan)
     pair = None
     if truth is not None:
@@ -132,12 +135,12 @@ def _truth_case(case, args, scene, spheres, passes, index, folder, rng, tables, 
         for i, v in enumerate(case.variants):
             if v.truth == "cycles":
                 c[index == i] = cyc[index == i]
-    brute, qerr, t_brute = suite.brute_force_radiance(case, scene, passes, index, args.brute_pixels, rng, tables,
+    brute, qerr, t_brute = suite_brute_force.brute_force_radiance(case, scene, passes, index, args.brute_pixels, rng, tables,
                                                       panels=args.panels, order=args.order)
     have = np.isfinite(brute).all(axis=-1)
     c[have] = brute[have]
     check_idx = [i for i, v in enumerate(case.variants) if v.truth == "cycles" and v.technique in BRUTE_CHECK]
-    check, _, t_check = (suite.brute_force_radiance(case, scene, passes, index, BRUTE_CHECK_PIXELS, rng, tables,
+    check, _, t_check = (suite_brute_force.brute_force_radiance(case, scene, passes, index, BRUTE_CHECK_PIXELS, rng, tables,
                                                     panels=args.panels, order=args.order, only=check_idx)
                          if check_idx and truth is not None and args.brute_check else (None, None, {}))
     return {"c": c, "samples": samples, "truth": truth, "pair": pair, "qerr": qerr, "t_brute": t_brute,
@@ -156,18 +159,18 @@ def _variant_entries(case, args, a, b, index, t):
                  "truth": v.truth, "material": {k: list(x) if isinstance(x, tuple) else x
                                                  for k, x in v.material().items()},
                  "features": v.features.as_dict(), "pixels": int(mask.sum()),
-                 "ab": suite.ab_metrics(a, b, mask)}
+                 "ab": suite_metrics.ab_metrics(a, b, mask)}
         cp = pair if v.truth == "cycles" else None
-        k = suite.cycles_error_exponent(v)
-        entry["truth_metrics"] = suite.truth_metrics(a, c, mask, args.floor, cp,
+        k = suite_metrics.cycles_error_exponent(v)
+        entry["truth_metrics"] = suite_metrics.truth_metrics(a, c, mask, args.floor, cp,
                                                      samples_total if cp else None,
                                                      qerr if v.truth == "brute" else None, error_exponent=k)
-        entry["truth_metrics_wide"] = suite.truth_metrics(a, c, mask, args.floor_wide, cp,
+        entry["truth_metrics_wide"] = suite_metrics.truth_metrics(a, c, mask, args.floor_wide, cp,
                                                           samples_total if cp else None,
                                                           qerr if v.truth == "brute" else None, error_exponent=k)
         entry["time_c"] = (sum(truth[1]) if (truth and v.truth == "cycles") else t["t_brute"].get(i, 0.0))
         if t["check"] is not None and i in t["check_idx"]:
-            entry["brute_check"] = suite.truth_metrics(c, t["check"], mask, args.floor)   # Cycles vs brute force
+            entry["brute_check"] = suite_metrics.truth_metrics(c, t["check"], mask, args.floor)   # Cycles vs brute force
             entry["brute_check_seconds"] = t["t_check"].get(i)
         rel, noise = metrics.rel_values(a, c, mask, args.floor, cp)
         rel_w, _ = metrics.rel_values(a, c, mask, args.floor_wide, cp)
@@ -217,7 +220,7 @@ def run_case(case, args, out_dir, rng, tables, log=print):
     scene, spheres, res, passes, a, index, t_build = _render_case(case, args, folder)
     b, t_b, conditioning = _numpy_case(case, scene, passes, index, tables)
     t = _truth_case(case, args, scene, spheres, passes, index, folder, rng, tables, a.shape)
-    ab_all = suite.ab_metrics(a, b, index >= 0, conditioning=conditioning, tol=args.ab_tol, atol=args.ab_atol)
+    ab_all = suite_metrics.ab_metrics(a, b, index >= 0, conditioning=conditioning, tol=args.ab_tol, atol=args.ab_atol)
     ab_ok = (ab_all["finite"] and ab_all["max_rel_beyond_float32"] <= args.ab_tol
              and ab_all["max_abs_near_zero_beyond_float32"] <= args.ab_atol)
     variants, pooled_parts = _variant_entries(case, args, a, b, index, t)
@@ -427,7 +430,7 @@ def _checks(args, cases, pooled, furnace):
         beyond = max(cases, key=lambda c: c["ab"].get("max_rel_beyond_float32", 0.0))
         conditioned = sum(c["ab"].get("conditioned", 0) for c in cases)
         checks.append({"name": "(a) vs (b), every case: max rel (|b| >= 1e-2) / max abs below; values over "
-                               f"the relative tolerance but within {suite.CONDITIONING_FACTOR:g} x their float32 "
+                               f"the relative tolerance but within {suite_metrics.CONDITIONING_FACTOR:g} x their float32 "
                                "conditioning (float64 moved by one float32 ulp of the inputs, and float32 vs float64) are allowed and counted",
                        "measured": f"{worst['ab']['max_rel']:.2e} ({worst['name']}); beyond float32 conditioning "
                                    f"{beyond['ab'].get('max_rel_beyond_float32', 0.0):.2e} ({beyond['name']}); "

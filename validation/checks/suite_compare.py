@@ -4,7 +4,7 @@ and roughness, pooled over the cases both runs rendered, from the images they sa
     python scripts/compare_validation.py BEFORE_DIR AFTER_DIR [--techniques ggx turquin ...] [--out FILE.md]
 
 Per case folder: node_a.exr (a), truth_c.exr (c; Cycles' two-seed mean or the brute force, 0 where not
-computed) and cycles_passes.exr (Position and Normal, which give each pixel's sphere, ``suite_cases.sphere_index``).
+computed) and cycles_passes.exr (Position and Normal, which give each pixel's sphere, ``suite_scene.sphere_index``).
 Per sphere the values (pixel x channel) above ``floor`` x the sphere's maximum of c (the suite's floor) are
 pooled; median, p90 and RMS of |a - c| / c, as validation.json's per-variant figures, which have no pooled RMS.
 The two runs must share the case generator (same ``--seed``, cell and samples): their truths are then the same
@@ -20,6 +20,7 @@ import numpy as np
 
 from ..harness import exr_images
 from . import suite_cases
+from . import suite_scene
 
 #: The techniques that use the GGX lobe under area lights (suite_cases.TECHNIQUES).
 GGX_TECHNIQUES = ("ggx", "turquin", "fdez_aguera", "dielectric", "metal", "kulla_conty", "turquin_color")
@@ -28,7 +29,7 @@ GGX_TECHNIQUES = ("ggx", "turquin", "fdez_aguera", "dielectric", "metal", "kulla
 def case_values(folder, case, floor):
     """{variant index: rel values} of one case folder."""
     ch = exr_images.read_channels(folder / "cycles_passes.exr")
-    index = suite_cases.sphere_index(case, exr_images.find_pass(ch, "Position", "XYZ"),
+    index = suite_scene.sphere_index(case, exr_images.find_pass(ch, "Position", "XYZ"),
                                      exr_images.find_pass(ch, "Normal", "XYZ"))
     a = exr_images.read_layer(folder / "node_a.exr").astype(np.float64)
     c = exr_images.read_layer(folder / "truth_c.exr").astype(np.float64)

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from ..harness.outputs import CSS, html_verdict, percent, scientific
-from .suite_cases import CYCLES_ERROR_EXPONENTS
+from .suite_metrics import CYCLES_ERROR_EXPONENTS
 
 
 def write_html(path, result):

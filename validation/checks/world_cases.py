@@ -45,6 +45,7 @@ import numpy as np
 from ...core.materials.rt_lit_interface import Features
 from ..harness import closures, scene_render
 from . import suite_cases
+from . import suite_scene
 from .suite_cases import Variant
 
 CELL = 2.2                          # world units per sphere cell (suite_cases.CELL)
@@ -378,7 +379,7 @@ def render_truth(scene, block, blocks, samples, seeds, folder, threads=2):
     frame(scene, block, blocks)
     images, seconds, normal = [], [], None
     for seed in seeds:
-        suite_cases.configure_truth_render(scene, samples, seed, threads)
+        suite_scene.configure_truth_render(scene, samples, seed, threads)
         path = Path(folder) / f"truth_seed{seed}.exr"
         seconds.append(scene_render.render_exr(scene, path))
         rgb, nrm = scene_render.read_passes(path)
@@ -505,7 +506,7 @@ def cell_alignment(block_a, normal_a, i, block_c, normal_c, j):
 
 def max_fraction(c, mask, floor_frac):
     """The floor ``floor_frac`` x median(c) over the mask's values, as a fraction of their max (what
-    suite_cases.truth_metrics and metrics.rel_values take).  Under an environment the max is a
+    suite_metrics.truth_metrics and metrics.rel_values take).  Under an environment the max is a
     sun's highlight, hundreds of times the typical value, so a max-relative floor would keep only the
     highlight; the median-relative floor keeps every value but the nearly black ones."""
     cv = np.asarray(c, np.float64)[mask].ravel()

@@ -33,7 +33,7 @@ def quiet(line):
 
 def script_arguments(argv):
     """The script's own arguments: what follows "--" when Blender runs it (``blender --background --python
-    scripts/x.py -- options``), else ``argv``."""
+    scripts/validate.py -- options``), else ``argv``."""
     argv = list(argv)
     return argv[argv.index("--") + 1:] if "--" in argv else argv
 
