@@ -52,6 +52,18 @@ from ..core import multiscatter
 from ..core import energy_checks as validation  # noqa: E402
 from ..core import lut_bake as bake
 from ..core.lut import catalog, lookup  # noqa: E402
+from ..core.export import luts as lut_export
+from .benchmarks import ltc_benchmark as benchmark_ltc
+from .benchmarks import ltc_random_lights
+from .benchmarks import realtime_benchmark
+from .benchmarks import speed_error
+from .checks import demo_measure as demo_report
+from .checks import energy_render as validate_energy
+from .checks import lookdev_twin
+from .checks import robustness
+from .checks import suite
+from .checks import world_suite
+from .harness import glsl_runner
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -111,7 +123,6 @@ def step_numpy_checks(lut_dir, log=entry.flush_log):
 
 def step_demo(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[6/13] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
-    from .checks import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
     result["summary_markdown"] = demo_report.format_markdown(result, image_prefix="demo/")
@@ -120,7 +131,6 @@ def step_demo(out_dir, lut_dir, eevee=True, log=entry.flush_log):
 
 def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[7/13] lookdev scene (New Lookdev Scene) vs its path-traced twin, Cycles and EEVEE")
-    from .checks import lookdev_twin
 
     result = lookdev_twin.run(out_dir / "lookdev", lut_dir=lut_dir, eevee=eevee, pictures_dir=REPO / "docs" / "images",
                               log=log)
@@ -132,7 +142,6 @@ def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=entry.flush_log):
 
 def step_lut_export(out_dir, lut_dir, log=entry.flush_log):
     log("[4/13] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
-    from ..core.export import luts as lut_export
 
     t0 = time.perf_counter()
     out = {"layouts": {}}
@@ -163,7 +172,6 @@ def step_lut_export(out_dir, lut_dir, log=entry.flush_log):
 def step_robustness(out_dir, lut_dir, log=entry.flush_log):
     log("[11/13] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
         "(scripts/robustness_sweep.py --points 2000)")
-    from .checks import robustness
 
     out = out_dir / "benchmarks" / "robustness.md"
     argv = ["--points", "2000", "--out", str(out)] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
@@ -185,7 +193,6 @@ def step_robustness(out_dir, lut_dir, log=entry.flush_log):
 def step_speed_error(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[12/13] speed vs error, quick: RT Lit's backends against path tracing at equal error "
         "(scripts/benchmark_speed_error.py --quick)")
-    from .benchmarks import speed_error
 
     folder = out_dir / "benchmarks" / "speed_error"
     cache = out_dir / "validation_world" / "env_cache"           # the world validation's bakes, when there
@@ -202,8 +209,6 @@ def step_speed_error(out_dir, lut_dir, eevee=True, log=entry.flush_log):
 
 def step_realtime_benchmark(out_dir, log=entry.flush_log):
     log("[8/13] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
-    from .harness import glsl_runner
-    from .benchmarks import realtime_benchmark
 
     glsl_runner.disable_shader_cache()
     ok, why = glsl_runner.available()
@@ -230,7 +235,6 @@ def _run_suite(module, folder, lut_dir, log):
 
 def step_validation(out_dir, lut_dir, log=entry.flush_log):
     log("[9/13] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
-    from .checks import suite
 
     result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
     return {"passed": bool(result["passed"]), "checks": result["checks"],
@@ -239,7 +243,6 @@ def step_validation(out_dir, lut_dir, log=entry.flush_log):
 
 def step_world_validation(out_dir, lut_dir, log=entry.flush_log):
     log("[10/13] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
-    from .checks import world_suite
 
     result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
     report_md = out_dir / "validation_world" / "report.md"
@@ -249,7 +252,6 @@ def step_world_validation(out_dir, lut_dir, log=entry.flush_log):
 
 def step_render(out_dir, lut_dir, resolution, samples, log=entry.flush_log):
     log("[5/13] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
-    from .checks import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
     result = validate_energy.run(out_dir=out_dir / "energy_render", lut_dir=lut_dir,
@@ -260,8 +262,6 @@ def step_render(out_dir, lut_dir, resolution, samples, log=entry.flush_log):
 
 def step_ltc(lut_dir, log=entry.flush_log):
     log("[3/13] LTC area lights: random quads and disks vs brute force")
-    from .benchmarks import ltc_benchmark as benchmark_ltc
-    from .benchmarks import ltc_random_lights
 
     t0 = time.perf_counter()
     tables = {name: benchmark_ltc.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}

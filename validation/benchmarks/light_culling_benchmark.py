@@ -24,6 +24,7 @@ import time
 import numpy as np
 
 from ..harness import outputs, scene_render
+from ...core.materials.rt_lit_interface import Features
 
 
 def demo_scene(lut_dir, resolution):
@@ -49,7 +50,6 @@ def grid_scene(lut_dir, resolution, rows=4, columns=4, spacing=4.0, light_range=
     import bpy
 
     from ...addon import compat, materials
-    from ...core.materials.rt_lit_interface import Features
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene

@@ -25,6 +25,14 @@ import time
 import numpy as np
 
 from ..harness import outputs
+from ...core import lights
+from ...core.ir.expr import table_filter
+from ...core.ir.numpy_backend import flat_node_count
+from ...core.lights import area_light_diameter
+from ...core.lut import lookup
+from ...core.lut.catalog import default_lut_dir
+from ...core.materials import rt_lit
+from ...core.materials.rt_lit_interface import Features, RT_LIT_INPUTS
 
 ANGLE_PAIRS = ((100.0, 90.0), (120.0, 110.0), (140.0, 130.0))     # (outer, inner), degrees: the talk's
 SHAPES = {"square 1 x 1 m": (1.0, 1.0), "rectangle 2 x 0.5 m": (2.0, 0.5)}
@@ -53,9 +61,6 @@ def _floor(points, height):
 
 def radiance(tables, kind, material, params, pos, view):
     """RT Lit's radiance from one light of ``kind`` at the floor points (numpy, float64)."""
-    from ...core.materials import rt_lit
-    from ...core.materials.rt_lit_interface import Features, RT_LIT_INPUTS
-
     specular, diffuse, roughness = material
     built = rt_lit.build_rt_lit(Features(specular, diffuse), (kind,))
     n = len(pos)
@@ -79,8 +84,6 @@ def _errors(quad, other):
 def talk_readings(pos, params, albedo=1.0):
     """Lambert radiance under the two other readings of the talk's fallback, both at the projector apex: an
     isotropic spot of intensity P / pi (its images) and a Lambertian one, P cos(theta) / pi; cone falloff as RT Lit."""
-    from ...core import lights
-
     loc = np.array([params["Location X"], params["Location Y"], params["Location Z"]])
     apex, axis = lights.projector_apex(loc, 1.0, 0.0, 0.0, 0.0, params["Scale X"], params["Scale Y"],
                                        params.get("Scale Z", 1.0), params["Size"], params["Size Y"],
@@ -95,9 +98,6 @@ def talk_readings(pos, params, albedo=1.0):
 
 def costs():
     """Operations of one light in the Cycles tree (Linear table reads) for each way of shading a quad."""
-    from ...core.ir.expr import table_filter
-    from ...core.ir.numpy_backend import flat_node_count
-    from ...core.materials import rt_lit
     from ...core.materials.rt_lit_interface import Features
 
     out = {}
@@ -113,10 +113,6 @@ def costs():
 
 
 def run(out=None, quick=False, lut_dir=None, log=print):
-    from ...core.lights import area_light_diameter
-    from ...core.lut import lookup
-    from ...core.lut.catalog import default_lut_dir
-
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir or default_lut_dir())
     rows = []

@@ -19,6 +19,8 @@ import json
 import statistics
 import time
 from pathlib import Path
+from ...core.lut import catalog
+from ...core.materials.rt_lit_interface import Features
 
 REPO = Path(__file__).resolve().parents[2]
 KINDS = (("AREA", "SQUARE"), ("AREA", "DISK"), ("POINT", None), ("SPOT", None), ("SUN", None))
@@ -26,7 +28,6 @@ KINDS = (("AREA", "SQUARE"), ("AREA", "DISK"), ("POINT", None), ("SPOT", None), 
 
 def _scene(bpy, objects, lights, lut_dir):
     from ...addon import compat, materials
-    from ...core.materials.rt_lit_interface import Features
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
@@ -68,7 +69,6 @@ def run(args, log=print):
     import bpy
 
     from ...addon import light_sync
-    from ...core.lut import catalog
 
     lut_dir = args.lut_dir or catalog.default_lut_dir()
     scene, made = _scene(bpy, args.objects, args.lights, lut_dir)

@@ -25,6 +25,10 @@ from ...core.lut import catalog, lookup
 from ..harness import entry, outputs, png as _png
 from .ltc_random_lights import (disk_exactness, disney_sheen_models, end_to_end, error_stats, fmt_stats,
     random_lights, sheen_markdown, sheen_via_diffuse_table, true_integral, zeltner_exactness)
+from ...core import rough_diffuse as rd
+from ...core.lut import exr_io
+from ...core.materials import lobes as rt_lobes
+from ..harness import published_ltc as ltc_anchor
 
 
 REPO = Path(__file__).resolve().parents[2]
@@ -198,7 +202,6 @@ def run(args, log=entry.flush_log):
     args.out.mkdir(parents=True, exist_ok=True)
     import os
     import platform
-    from ..harness import published_ltc as ltc_anchor
 
     res = {"machine": f"{platform.machine()}, {os.cpu_count()} cores", "date": time.strftime("%Y-%m-%d")}
     if getattr(args, "lobes", None):
@@ -245,8 +248,6 @@ def run(args, log=entry.flush_log):
 
 
 def exr_io_read(lut_dir, name):
-    from ...core.lut import exr_io
-
     spec = catalog.TABLES[name]
     return exr_io.read_table(Path(lut_dir) / spec.filename, spec.name, spec.shape)[0].astype(np.float64)
 
@@ -258,9 +259,6 @@ def rough_diffuse_area_forms(tables, n_quads, n_disks, seed=2024):
     kernel over the light as shipped (Lambert form factor x its ratio towards the light's centre) and through the
     fixed LTC fitted to it (``rough_diffuse.MS_KERNEL_LTC``), and the whole lobe at albedo 1 as RT Lit computes it
     (``lobes.OREN_NAYAR``: the single scattering's LTC x the closed-form albedo, plus the kernel's share)."""
-    from ...core import rough_diffuse as rd
-    from ...core.materials import lobes as rt_lobes
-
     luts = lookup.LutSet.from_folder(tables["lut_dir"])
     sphere = tables["ltc_ggx_mag"][..., 3]
     results = {}

@@ -7,6 +7,8 @@ import numpy as np
 from ...core.ir import semantics
 from ...core.ltc import disk, fit, fit_lobes as lobes, matrix, polygon, reference, shading
 from ...core.lut import catalog, lookup
+from ...core import cloth
+from ...core import sheen
 
 
 # --- end-to-end: random lights ---------------------------------------------------------------
@@ -144,8 +146,6 @@ def end_to_end(tables, published, n_quads, n_disks, seed=2019, prefixes=None):
 
 
 def _disney_sheen_f_cos(l, vv):
-    from ...core import cloth
-
     h = l + vv
     h /= np.linalg.norm(h, axis=-1, keepdims=True)
     return cloth.disney_sheen(np.sum(l * h, axis=-1)) * np.maximum(l[..., 2], 0.0)
@@ -198,8 +198,6 @@ def zeltner_exactness(lut_dir, n_quads, n_disks, seed=2022):
     same table values): the LTC integral with the sphere table's horizon ("sphere table") and with the exact
     horizon RT Lit shades it with ("exact horizon": quads clipped, disks by their closed form above the
     horizon and an equal-area 12-gon clipped where they cross it).  Random sheen roughness in [0.05, 1]."""
-    from ...core import sheen
-
     tables = lookup.LutSet.from_folder(lut_dir)
     sheen_table = tables.array("zeltner_sheen")
     sphere = tables.array("ltc_ggx_mag")[..., 3]

@@ -23,6 +23,8 @@ import time
 from pathlib import Path
 
 from ..harness import entry, outputs
+from ...core.materials import light_shading
+from ..checks import suite
 
 REPO = Path(__file__).resolve().parents[2]
 #: How the specular of a partly metallic surface is shaded: the one mixed F0 (before) or each F0 apart (shipped).
@@ -32,9 +34,6 @@ CASES, QUICK_CASES = ("metallic_mix_quad", "metallic_mix_disk", "metallic_mix_po
 
 def measure(shading, cases, work):
     """Run in the child process: the suite's ``cases`` with ``shading``; its results land in ``work``."""
-    from ...core.materials import light_shading
-    from ..checks import suite
-
     if shading == "mixed_f0":
         light_shading.SPLIT_F0_MODELS = ()
     args = suite.parse_args(["--cases", *cases, "--out", str(work), "--skip-furnace"])

@@ -37,6 +37,9 @@ from ...core.lut import catalog, exr_io
 from ...core.materials import rt_lit
 from ...core.materials.rt_lit_interface import Features, LIGHT_KINDS
 from ..harness import entry, glsl_runner, grids
+from ...core.ir.semantics import sample_bilinear
+from ...core.lut.lookup import LutSet
+from ..harness.realtime_render import RealtimeRenderer
 
 REPO = Path(__file__).resolve().parents[2]
 FEATURE_SETS = {"minimal": (Features("single", "lambert"), False),
@@ -168,8 +171,6 @@ def write_scene(folder, features, world, count, resolution, lut_dir):
 
 def measure(desc, frames, precise):
     """One configuration: {"emit_seconds", "compile_seconds", "first_frame_seconds", "frame_*", ...}."""
-    from ..harness.realtime_render import RealtimeRenderer
-
     t0 = time.perf_counter()
     with RealtimeRenderer(desc, precise=precise) as renderer:
         setup = time.perf_counter() - t0
@@ -203,8 +204,6 @@ def hardware_filtering_deviation(table, samples=256, seed=1):
     ``table`` at random coordinates.  The backend does not rely on it (four texel fetches instead): the
     D3D11/12 specifications require only 8 bits of sub-texel precision (D3D11_SUBTEXEL_FRACTIONAL_BIT_COUNT),
     so GPUs quantise the weights; llvmpipe computes them in float."""
-    from ...core.ir.semantics import sample_bilinear
-
     ctx = glsl_runner.context()
     rng = np.random.default_rng(seed)
     uv = rng.uniform(0.0, 1.0, (samples, samples, 3)).astype(np.float32)
@@ -283,7 +282,6 @@ def run(args, log=entry.flush_log):
                     log(f"{fname:8s} {count:2d} lights precise={precise!s:5s}: frame {1e3 * r['frame_seconds_median']:8.1f} ms "
                         f"(min {1e3 * r['frame_seconds_min']:.1f}), compile {r['compile_seconds']:.2f} s, first frame "
                         f"{r['first_frame_seconds']:.2f} s, {r['shader_lines']} lines")
-    from ...core.lut.lookup import LutSet
 
     filtering = hardware_filtering_deviation(LutSet.from_folder(lut_dir).array("ltc_ggx_inv"))
     result = {"date": time.strftime("%Y-%m-%d"), "resolution": [args.width, args.height], "frames": args.frames,

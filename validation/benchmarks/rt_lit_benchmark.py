@@ -37,6 +37,9 @@ import numpy as np
 
 from ..harness import entry
 from ...core.materials.cycles_capacity import SEARCHED_UP_TO as MAX_LIGHTS
+from ...core.materials import rt_lit
+from ...core.materials.rt_lit_interface import Features
+from ...core.materials.rt_lit_interface import rt_lit_group_name
 
 
 REPO = Path(__file__).resolve().parents[2]
@@ -227,8 +230,6 @@ def ir_counts(features, lights=1):
     import bpy
 
     from ...addon import materials, world_sync
-    from ...core.materials import rt_lit
-    from ...core.materials.rt_lit_interface import rt_lit_group_name
 
     counts = {}
     for world in (NO_WORLD, WORLD_TERM):
@@ -254,8 +255,6 @@ def _ratio(a, b):
 
 def feature_sets(only=None):
     """The measured feature sets; with ``only``, those whose label contains one of its strings."""
-    from ...core.materials.rt_lit_interface import Features
-
     sets = [Features("single", "lambert"), Features("turquin", "cod"), Features("fdez_aguera", "lambert"),
             Features("kulla_conty", "lambert"), Features("turquin", "cod", sheen=True),
             Features("single", "cod", cloth=True), Features("kulla_conty", "wrapped", sheen=True, cloth=True)]

@@ -34,6 +34,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from ...core import lut_bake
+from ...core.lut import catalog, exr_io
+from ..harness.render_setup import configure_cycles_measurement
 
 #: Cycles' table size and roughness floor (src/kernel/closure/bsdf_sheen.h, bsdf_sheen_setup).
 SIZE = 32
@@ -125,7 +128,6 @@ def solve_node0(measured, node1, r_measured=None):
 def _scene(bpy, cells, distribution="MICROFIBER"):
     """A scene whose pixel (row j from the top, column i) shades cell ``cells[j][i]`` = (mu, r)."""
     from ...addon import compat
-    from ..harness.render_setup import configure_cycles_measurement
 
     cells = np.asarray(cells, np.float64)
     height, width = cells.shape[:2]
@@ -313,9 +315,6 @@ def write_measured(lut_dir, table=None, report=None):
     tables into ``lut_dir`` with their provenance: ``zeltner_sheen.exr`` and the moments derived from it
     (``sh_moments``: ``zeltner_sheen_sh1.exr``, ``zeltner_sheen_sh2.exr``); returns (path, report)."""
     import bpy
-
-    from ...core import lut_bake
-    from ...core.lut import catalog, exr_io
 
     if table is None:
         table, report = measure_table()

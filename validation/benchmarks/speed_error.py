@@ -52,6 +52,8 @@ from .speed_error_metrics import decay_exponent, errors, make_reference, pt_cost
 from .speed_error_report import (exponent_summary, family_summary, fmt_speedup, format_markdown, plot_families,
     summary_table)
 from .speed_error_scenes import FLOOR, LADDER_SEED, METRICS, plan, prepare, REF_SEEDS, REPO
+from ...core.lut import lookup
+from ..harness import glsl_runner
 
 
 # --- one case ------------------------------------------------------------------------------------------
@@ -163,8 +165,6 @@ def _cpu_model():
 def _settings(p, threads, command, eevee, glsl):
     import bpy
 
-    from ..harness import glsl_runner
-
     s = {"date": time.strftime("%Y-%m-%d %H:%M"), "cpu_model": _cpu_model(), "cpu_count": os.cpu_count(),
          "platform": platform.platform(), "blender": bpy.app.version_string, "threads": threads,
          "quick": p.quick, "cell_px": p.cell, "eevee_repeats": p.eevee_repeats,
@@ -182,9 +182,6 @@ def run(out_dir, lut_dir=None, quick=True, log=print, cases=None, cell=None, thr
     speed_error.{md,json} and the PNG plots into ``out_dir``; returns the result with "summary_markdown" (the
     family-median table) and "passed" (every error finite).  ``ladder_max`` / ``ref_spp``: caps on the ladder's
     top and the references' samples (small development runs)."""
-    from ...core.lut import lookup
-    from ..harness import glsl_runner
-
     glsl_runner.disable_shader_cache()          # before any OpenGL context, Blender's (EEVEE) included
     t_start = time.perf_counter()
     out_dir = Path(out_dir)

@@ -10,6 +10,14 @@ import numpy as np
 
 from .speed_error_scenes import (CHEAP_SECONDS, CYCLES_SLOPE_SPP, EEVEE_REPEATS, EEVEE_SLOPE_SPP, GLSL_FRAMES,
     GLSL_WIDTH, TIMING_REPEATS)
+from ...core.ir import shader_text
+from ...core.materials import rt_lit
+from ...core.materials.rt_lit_interface import RADIANCE_OUTPUT
+from ..checks.suite_scene import configure_truth_render
+from ..checks.suite_scene import material_values, scene_light_params
+from ..checks.suite_scene import numpy_radiance
+from ..harness import exr_images
+from ..harness import glsl_runner
 
 
 # --- renders -----------------------------------------------------------------------------------------
@@ -22,9 +30,7 @@ def render(scene, spp, seed, folder, threads=2, passes=False):
     import bpy
 
     from ...addon import compat
-    from ..harness import exr_images
     from ..harness.engines import output_settings
-    from ..checks.suite_scene import configure_truth_render
 
     w, h = scene.render.resolution_x, scene.render.resolution_y
     path = Path(folder) / f"se_{abs(hash(scene.name)) % 10**8}_{spp}_{seed}.exr"
@@ -126,9 +132,7 @@ def backend_eevee(prep, folder, repeats=EEVEE_REPEATS):
 def _material_inputs(prep, i, passes, mask):
     """(RtLitMaterial, input values) of sphere i at the pixels ``mask`` of the passes: what
     ``suite_cases.numpy_radiance`` evaluates, per-pixel arrays for Position, Geometry Normal, Incoming."""
-    from ...core.materials import rt_lit
     from ..harness.engines import camera_incoming
-    from ..checks.suite_scene import material_values, scene_light_params
 
     lights = scene_light_params(prep.scene)
     env, world_params = prep.world if prep.world is not None else (None, {})
@@ -159,10 +163,6 @@ class _GlslDraws:
         return obj
 
     def program(self, material):
-        from ...core.ir import shader_text
-        from ...core.materials.rt_lit_interface import RADIANCE_OUTPUT
-        from ..harness import glsl_runner
-
         key = material.function.name
         if key not in self.programs:
             t0 = time.perf_counter()
@@ -176,8 +176,6 @@ class _GlslDraws:
         return self.programs[key]
 
     def add(self, material, values, luts, n):
-        from ..harness import glsl_runner
-
         module, program = self.program(material)
         t0 = time.perf_counter()
         h = -(-n // GLSL_WIDTH)
@@ -234,8 +232,6 @@ def backend_glsl(prep, passes, masks_all, luts):
     Cycles passes (every pixel of the sphere one fragment of a full-screen pass: deferred shading of a
     G-buffer).  Total: emit + compile + upload of the inputs and tables + the first frame (the driver
     finishes compiling at the first draw); render only: the median of ``GLSL_FRAMES`` frames after it."""
-    from ..harness import glsl_runner
-
     ok, why = glsl_runner.available()
     if not ok:
         return {"skipped": why}
@@ -264,8 +260,6 @@ def backend_numpy(prep, passes, index0, luts):
     the median of ``TIMING_REPEATS`` evaluations (the traced function is built with the scene, for every
     backend, and not counted)."""
     from types import SimpleNamespace
-
-    from ..checks.suite_scene import numpy_radiance
 
     variants = [SimpleNamespace(features=v["features"]) for v in prep.variants]
     p = {"Position": passes["position"], "Normal": passes["normal"]}

@@ -9,6 +9,8 @@ import numpy as np
 
 from .speed_error_backends import median, render
 from .speed_error_scenes import CHEAP_SECONDS, FLOOR, LADDER_SEED, TIMING_REPEATS
+from ..checks import world_cases as vw
+from ..checks.suite_metrics import truth_metrics
 
 
 # --- metrics -----------------------------------------------------------------------------------------
@@ -72,8 +74,6 @@ class Reference:
 
 def errors(test, ref):
     """Per sphere: {"rel_rms" (noise-corrected), "rel_rms_raw", "resolved", "rel_median", "flip"} of ``test``."""
-    from ..checks.suite_metrics import truth_metrics
-
     fmap = flip_map(ref.image, test, ref.composite, ref.exposure)
     out = []
     for mask, floor, noise in zip(ref.masks, ref.floors, ref.noise):
@@ -89,9 +89,6 @@ def errors(test, ref):
 def make_reference(prep, renders, masks, composite):
     """The mean of the two seeds, the floors (FLOOR x the sphere's max; under a world FLOOR x its median,
     ``world_cases.max_fraction``) and the reference's own noise per sphere."""
-    from ..checks import world_cases as vw
-    from ..checks.suite_metrics import truth_metrics
-
     pair = [r["rgb"] for r in renders]
     c = 0.5 * (pair[0] + pair[1])
     floors = [vw.max_fraction(c, m, FLOOR) if prep.floor_mode == "median" else FLOOR for m in masks]

@@ -7,6 +7,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..harness import closures
+from ...core.environment import equirect
+from ..checks import lookdev_twin
+from ..checks import suite_cases as suite
+from ..checks import suite_scene
+from ..checks import world_cases as vw
+from ..checks.world_suite import QUICK, ROTATED
 
 
 REPO = Path(__file__).resolve().parents[2]
@@ -68,8 +74,6 @@ def plan(quick=False, cell=None):
     case for path tracing) and the demo scene at 160 x 160; references 4096 spp x 2 (the demo 1024 x 2), ladder to
     4096 spp (the demo 1024).  Quick (about 2 minutes): one quad case, one disk case and the forest world with
     two or three spheres each, ladder to 256 spp, references 1024 x 2, EEVEE timed once per sample count."""
-    from ..checks.world_suite import QUICK, ROTATED
-
     if quick:
         cases = [CaseSpec("quad1", "suite", "quad1_closures", AREA_VARIANTS[:3], ref_spp=1024),
                  CaseSpec("disk4", "suite", "disk4_closures", (("lambert", 0.5), ("ggx", 0.5)), ref_spp=1024),
@@ -146,9 +150,6 @@ def _variant_record(kind, technique, roughness, label, features, light_kinds=())
 
 
 def _prepare_suite(spec, cell, lut_dir):
-    from ..checks import suite_cases as suite
-    from ..checks import suite_scene
-
     base = {c.name: c for c in suite.build_cases(seed=0)}[spec.source]
     variants = [suite.Variant(t, r) for t, r in spec.variants]
     case = suite.Case(spec.name, base.lights, variants, columns=min(spec.columns, len(variants)),
@@ -162,9 +163,6 @@ def _prepare_suite(spec, cell, lut_dir):
 
 
 def _prepare_world(spec, cell, lut_dir, cache_dir):
-    from ...core.environment import equirect
-    from ..checks import world_cases as vw
-
     hdri, rotation, strength = spec.world
     wspec = vw.WorldSpec(spec.name, str(equirect.resolve_hdri(hdri)), rotation, strength, hdri=hdri)
     scene = vw.new_scene()
@@ -185,8 +183,6 @@ def _prepare_world(spec, cell, lut_dir, cache_dir):
 def _prepare_demo(spec, resolution, lut_dir):
     from ...addon import demo_scene, lookdev_scene
     from ...addon import world_sync
-    from ..checks import lookdev_twin
-    from ..checks import world_cases as vw
 
     features = demo_scene.build_demo_scene(lut_dir, resolution)
     import bpy

@@ -22,6 +22,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+from ...core.materials.rt_lit_interface import Features
+from .rt_lit_benchmark import captured_output, lights_scene
 
 LIGHTS = (1, 2, 4, 8, 12)
 LIGHTS_QUICK = (1, 4)
@@ -32,8 +34,6 @@ BASE_RESOLUTION = 128
 
 
 def _features_sets():
-    from ...core.materials.rt_lit_interface import Features
-
     return [Features("single", "lambert"), Features("turquin", "cod"), Features("kulla_conty", "lambert"),
             Features("turquin", "cod", sheen=True), Features("single", "cod", cloth=True),
             Features("kulla_conty", "wrapped", sheen=True, cloth=True)]
@@ -58,8 +58,6 @@ def timed_configs(configs, rounds, log=print):
     """configs: {key: (features, lights, resolution)} -> {key: {"seconds": median, "runs": [...],
     "nodes": {"Cycles": n, "EEVEE": n}}}."""
     import bpy
-
-    from .rt_lit_benchmark import captured_output, lights_scene
 
     out = {}
     with tempfile.TemporaryDirectory(prefix="rtl-scaling-") as tmp:
@@ -88,7 +86,6 @@ def eevee_compile(features_list, log=print):
     import bpy
 
     from ..harness.engines import eevee_available
-    from .rt_lit_benchmark import captured_output, lights_scene
 
     ok, _ = eevee_available()
     if not ok:
@@ -119,8 +116,6 @@ def fit_line(x, y):
 
 def run(quick=False, rounds=3, eevee=True, log=print):
     """Measure; returns the JSON-ready result with a "markdown" entry."""
-    from ...core.materials.rt_lit_interface import Features
-
     t0 = time.perf_counter()
     typical = Features("turquin", "cod")
     lights = LIGHTS_QUICK if quick else LIGHTS

@@ -23,6 +23,12 @@ import time
 import numpy as np
 
 from ..harness import outputs
+from ...core import diffuse
+from ...core import indirect
+from ...core.conventions import alpha_from_roughness
+from ...core.ltc import shading
+from ...core.lut import lookup
+from ...core.lut.catalog import default_lut_dir
 
 WRAPS = (0.0, 0.5, 1.0)
 ROUGHNESS = (0.3, 0.8)
@@ -35,8 +41,6 @@ def _unit(x):
 def random_light(rng, kind, wrap):
     """(light for core.ltc.shading, the brute-force geometry, size, distance): one seeded light seen from the origin
     (normal +Z), its centre from -wrap (sine of the elevation) to the zenith, facing the origin."""
-    from ...core.ltc import shading
-
     el = np.arcsin(rng.uniform(-0.9 * wrap, 1.0) if wrap > 0 else rng.uniform(0.05, 1.0))
     az, dist, size = rng.uniform(0, 2 * np.pi), rng.uniform(1.5, 4.0), rng.uniform(0.3, 2.0)
     c = dist * np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
@@ -55,8 +59,6 @@ def random_light(rng, kind, wrap):
 
 def area_row(tables, kind, wrap, roughness, lights, seed):
     """Relative errors of the shipped area form and the talk's against the lobe's integral over ``lights`` lights."""
-    from ...core import diffuse
-    from ...core.conventions import alpha_from_roughness
     from ...core.ltc import reference, shading
 
     rng = np.random.default_rng(seed)
@@ -98,8 +100,6 @@ def _sky(d):
 
 def sh_rows(tables, points, seed):
     """Mean / median relative error of the SH forms against the lobe under the same SH environment."""
-    from ...core import indirect
-
     rng = np.random.default_rng(seed)
     n, v = _unit(rng.normal(size=(points, 3))), _unit(rng.normal(size=(points, 3)))
     v = np.where((np.sum(n * v, -1) < 0.05)[:, None], -v, v)
@@ -124,7 +124,6 @@ def sh_rows(tables, points, seed):
 def albedo_rows(views=6):
     """The punctual lobe's directional albedo at w = 0.5 and 1 against w = 0 (the CoD lobe's)."""
     from ...core import diffuse, indirect
-    from ...core.conventions import alpha_from_roughness
 
     rng = np.random.default_rng(1)
     n = np.tile([0.0, 0.0, 1.0], (views, 1))
@@ -172,9 +171,6 @@ def markdown(result):
 
 
 def run(out=None, lights=120, quick=False, lut_dir=None, log=print):
-    from ...core.lut import lookup
-    from ...core.lut.catalog import default_lut_dir
-
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir or default_lut_dir())
     if quick:

@@ -30,6 +30,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from ...core.materials import rt_lit
+from ...core.materials.rt_lit_interface import Features
+from ..harness import glsl_runner
+from ..harness import png as _png
+from ..harness.realtime_render import RealtimeRenderer
 
 
 REPO = Path(__file__).resolve().parents[2]
@@ -55,8 +60,6 @@ def node_counts(scene_materials):
     from ...addon import materials
     from ...addon.common import FEATURES_KEY
     from ...addon.node_emit import tree_node_counts
-    from ...core.materials import rt_lit
-    from ...core.materials.rt_lit_interface import Features
 
     groups = {}
     per_features = {}
@@ -85,10 +88,7 @@ def measure_realtime(scene, cycles, out_dir, lut_dir=None, repeats=5, log=print)
     """Export ``scene``, draw it with the GLSL renderer at the render's size and compare with ``cycles``
     (H, W, 3, row 0 at the top): the "realtime" entry of demo.json."""
     from ...addon import scene_export
-    from ..harness import glsl_runner
-    from ..harness import png as _png
     from ..harness.engines import compare
-    from ..harness.realtime_render import RealtimeRenderer
 
     glsl_runner.disable_shader_cache()
     ok, why = glsl_runner.available()
@@ -130,7 +130,6 @@ def run(out_dir, lut_dir=None, resolution=256, repeats=3, eevee=True, log=print,
 
     from ...addon import demo_scene as build_demo_scene
     from ..harness.engines import compare, eevee_available, render_engines
-    from ..harness import png as _png
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -42,6 +42,7 @@ from ...core import lut_bake as bake
 from ...core.lut import catalog
 from ...core.lut.lookup import LutSet
 from ..harness import outputs, scene_render
+from ..harness.render_setup import configure_cycles_measurement
 
 #: Bin edges in mu for the report; bins below MU_JUDGED are reported, not judged.
 MU_EDGES = tuple(float(x) for x in np.round(np.linspace(0.0, 1.0, 11), 10))
@@ -149,7 +150,6 @@ def configure_render(scene, samples, seed, threads=2):
     """Cycles settings for an unbiased, unclamped, point-sampled linear render
     (validation/harness/render_setup.py), plus what the furnace needs: glossy bounces, no glossy filter."""
     from ...addon import compat
-    from ..harness.render_setup import configure_cycles_measurement
 
     configure_cycles_measurement(scene, samples, seed, threads)
     c = scene.cycles

@@ -24,6 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from ..harness import exr_images, metrics
+from ..harness import png
+from ..harness.render_setup import configure_cycles_measurement
 
 #: Reference values below this fraction of the sphere's maximum are not compared (the suite's floor).
 FLOOR_FRACTION = 0.01
@@ -64,7 +66,6 @@ def render_measurement(scene, resolution, samples, seed, folder):
 
     from ...addon import compat
     from ..harness.engines import output_settings
-    from ..harness.render_setup import configure_cycles_measurement
 
     exr = Path(folder) / f"{scene.name.replace(' ', '_')}_{seed}.exr"
     with _kept_settings(scene):
@@ -251,8 +252,6 @@ def _display(rgb):
 def write_pictures(result, folder, prefix="lookdev_"):
     """PNG previews: the RT Lit render, the path-traced twin, and the twin without the spheres' shadows;
     returns their paths."""
-    from ..harness import png
-
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     paths = []

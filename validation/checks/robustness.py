@@ -35,6 +35,12 @@ from ...core.materials import rt_lit
 from ...core.materials.rt_lit_interface import Features, RADIANCE_OUTPUT
 from .robustness_inputs import (AREA_KINDS, bound, BOUND_TOLERANCE, FAMILIES, Family, geometry_values, HORIZON_BAND,
     LAYERED, LIGHT_KINDS, material_values, NEAR_ZERO, scene_inputs)
+from ...core.environment import sh
+from ...core.ir import shader_text
+from ...core.lut import exr_io
+from ...core.lut.lookup import LutSet
+from ...core.materials import world_shading
+from ..harness import glsl_runner
 
 
 @dataclass
@@ -197,13 +203,8 @@ def world_furnace_inputs(n, seed=0):
     """Inputs of the World-term family: the RT Lit material with every technique on, no lights, under a
     constant environment of radiance 1 (exact SH and prefiltered levels), white colours; the radiance
     must stay at most 1 (+ the sheen weight).  Returns (values, material, environment)."""
-    from ...core.environment import sh
-    from ...core.materials import world_shading
-
     import tempfile
     from pathlib import Path
-
-    from ...core.lut import exr_io
 
     levels = "[" + ", ".join(str(k / 8.0) for k in range(9)) + "]"
     path = Path(tempfile.mkdtemp(prefix="rtl-furnace-")) / "env_white_furnace_prefiltered.exr"
@@ -250,9 +251,6 @@ def counts_json(counts):
 
 def sweep_glsl(cases, luts, width=1024, log=print):
     """[Counts] of the GLSL 4.50 backend (llvmpipe or a GPU) on the numpy sweep's inputs (``cases``)."""
-    from ...core.ir import shader_text
-    from ..harness import glsl_runner
-
     runner = glsl_runner.GlslRunner()
     counts = []
     for (family_name, kind), (values, unit, material, ref64, _) in cases.items():
@@ -427,8 +425,6 @@ def run(args, log=print):
     """The sweep of ``parse_args``: writes ``args.out`` (.md) and its .json; returns the result dict."""
     import json
     import platform
-
-    from ...core.lut.lookup import LutSet
 
     luts = LutSet.from_folder(args.lut_dir) if args.lut_dir else LutSet.from_folder()
     backends = [b.strip() for b in args.backends.split(",") if b.strip()]

@@ -71,6 +71,10 @@ from . import suite_cases as suite, suite_html
 from . import suite_brute_force
 from . import suite_metrics
 from . import suite_scene
+from . import energy_render as ve
+from ...core import energy_checks as core_validation
+from ...core import multiscatter
+from ...core.lut import lookup
 
 DEFAULTS = {"ab_tol": 1e-4, "ab_atol": 1e-6, "lambert_median": 0.005, "ggx_quad_median": 0.02,
             "ggx_quad_p90": 0.12, "furnace_tol": 0.005, "floor": 0.1, "floor_wide": 0.01}
@@ -240,10 +244,6 @@ def run_case(case, args, out_dir, rng, tables, log=print):
 # --- furnace -----------------------------------------------------------------------------------
 
 def run_furnace(args, out_dir, log=print):
-    from . import energy_render as ve
-    from ...core import multiscatter
-    from ...core import energy_checks as core_validation
-
     folder = out_dir / "furnace"
     roughness = (0.25, 0.5, 0.75, 1.0)
     t0 = time.perf_counter()
@@ -503,8 +503,6 @@ def parse_args(argv):
 
 
 def run(args, log=print):
-    from ...core.lut import lookup
-
     t_start = time.perf_counter()
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -8,6 +8,11 @@ import time
 import numpy as np
 
 from .suite_scene import numpy_material, scene_light_params
+from ...core import lights as core_lights
+from ...core.ltc import reference
+from ...core.materials import light_shading
+from ...core.materials.rt_lit_interface import RT_LIT_INPUTS
+from ...core.materials.surface import SURFACE
 
 
 # --- (c) brute-force ground truth -------------------------------------------------------------
@@ -17,8 +22,6 @@ def _area_geometry(kind, params, position=None):
     its options' falloff (``core.lights.control_factor``) and without the spread (its weight is taken per direction:
     ``_direction_weight``); a sphere light's or a sun's disk facing ``position``, a spot sphere's without its cone
     (taken per direction too)."""
-    from ...core import lights as core_lights
-
     base = core_lights.base_kind(kind)
     data = core_lights.LIGHT_DATA["sphere" if base == "spot_sphere" else base]
     args = {k: np.float64(v) for k, v in params.items() if k in data.input_sockets}
@@ -55,8 +58,6 @@ def _direction_weight(kind, params, position, dirs, light_normal):
 
 def quadrature_rule(kind, geo, p, clip_normal, panels, order):
     """Points relative to p (M, 3), area weights (M,), unit light normal, or None if unlit."""
-    from ...core.ltc import reference
-
     if kind == "quad":
         rel = geo["corners"] - p
         normal = reference.newell_normal(rel)
@@ -73,9 +74,6 @@ def quadrature_rule(kind, geo, p, clip_normal, panels, order):
 
 
 def _surface(features, material, n, v):
-    from ...core.materials.rt_lit_interface import RT_LIT_INPUTS
-    from ...core.materials.surface import SURFACE
-
     return SURFACE(**{k: material[k] for k in RT_LIT_INPUTS}, **{"Geometry Normal": n, "Incoming": v})
 
 
@@ -87,8 +85,6 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
     variant).  The error estimate is |I(panels) - I(panels / 2)| (reference._converged's check).
     Pixels are evaluated in chunks: the rule's points of ``chunk`` pixels go through one call of
     the shading function (numpy, float64; ``tables`` the LUT set the punctual GGX reads E from)."""
-    from ...core import lights as core_lights
-    from ...core.materials import light_shading
     from ..harness.engines import camera_incoming
 
     import bpy

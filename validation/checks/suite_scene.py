@@ -9,6 +9,9 @@ import numpy as np
 
 from ..harness import closures, scene_render
 from .suite_cases import CELL, sphere_centres
+from ...core.materials import rt_lit
+from ...core.materials.rt_lit_interface import RT_LIT_INPUTS
+from ..harness.render_setup import configure_cycles_measurement
 
 
 # --- scene ------------------------------------------------------------------------------------
@@ -138,8 +141,6 @@ def scene_light_params(scene, receiver=None):
 
 def numpy_material(variant):
     """RT_LIT_INPUTS name -> the variant's value (the socket default where the variant sets none)."""
-    from ...core.materials.rt_lit_interface import RT_LIT_INPUTS
-
     out = {}
     for name, sock in RT_LIT_INPUTS.items():
         v = variant.material().get(name, sock.default)
@@ -165,7 +166,6 @@ def numpy_radiance(scene, variants, objects, passes, index, tables, world=None, 
     by the numpy backend at the render's Position / Normal passes with the material node's values, the
     lights' driver values and the world's parameters; float32 with Cycles' node semantics (float64 on
     request).  ``objects[i]`` carries variant i's material; ``world``: None or (WorldEnvironment, params)."""
-    from ...core.materials import rt_lit
     from ..harness.engines import camera_incoming
 
     pos = passes["Position"].astype(np.float64)
@@ -209,7 +209,6 @@ def conditioning(fn, passes, b=None):
 
 def configure_truth_render(scene, samples, seed, threads=2):
     from ...addon import compat
-    from ..harness.render_setup import configure_cycles_measurement
 
     configure_cycles_measurement(scene, samples, seed, threads)
     c = scene.cycles

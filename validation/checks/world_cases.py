@@ -47,6 +47,12 @@ from ..harness import closures, scene_render
 from . import suite_cases
 from . import suite_scene
 from .suite_cases import Variant
+from . import suite_cases as suite
+from ...core.conventions import ALPHA_MIN
+from ...core.diffuse import cod_multiscatter_diffuse, cod_wrapped_diffuse_cosine
+from ...core.environment import equirect
+from ...core.microfacet import ggx_brdf
+from ..harness import exr_images
 
 CELL = 2.2                          # world units per sphere cell (suite_cases.CELL)
 BLOCK_GAP = 60.0                    # the truth block sits this far below the node block (Z)
@@ -97,8 +103,6 @@ def rough_diffuse_variants():
 def technique_material(technique, roughness):
     """RT Lit input values (suite_cases.technique_material): white Lambert / CoD (built without
     specular: ``TECHNIQUES``), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
-    from . import suite_cases as suite
-
     if technique in ("oren_nayar", "cod_cycles"):
         return suite.technique_material(technique, roughness, suite.WHITE)
     base = technique if technique in ("lambert", "cod", "cod_wrapped", "zeltner") else "ggx"
@@ -233,8 +237,6 @@ class Block:
 
 def write_constant_equirect(path, value=1.0, width=64, height=32):
     """A constant equirect EXR (the uniform furnace world as an Environment Texture)."""
-    from ..harness import exr_images
-
     return exr_images.write_rgb(path, np.full((height, width, 3), float(value), np.float32))
 
 
@@ -401,8 +403,6 @@ def world_params_numpy(params):
 def image_quadrature(image, size=(128, 64)):
     """Texel directions (T, 3) (image frame), solid-angle weights (T,) and radiance (T, 3) of an equirect
     image area-averaged (equirect.downsample, solid-angle weighted) to ``size`` = (W, H)."""
-    from ...core.environment import equirect
-
     image = np.asarray(image, np.float32)
     w, h = size
     f = image.shape[1] // w
@@ -430,9 +430,6 @@ def cod_reference_image(quad, n, v, roughness, chunk=64, wrap=None):
     int L(l) f_CoD(l, v) (n.l) dl, n and v (K, 3) unit in the image frame, roughness (K,) -> (K, 3).
     With ``wrap`` (a float): the multiscattering wrapped diffuse instead (``core.diffuse.cod_wrapped_diffuse_cosine``,
     whose support reaches below the horizon)."""
-    from ...core.conventions import ALPHA_MIN
-    from ...core.diffuse import cod_multiscatter_diffuse, cod_wrapped_diffuse_cosine
-
     dirs, wts, rad = quad
     n = np.asarray(n, np.float64)
     v = np.asarray(v, np.float64)
@@ -536,9 +533,6 @@ def ggx_reference_image(quad, n, v, roughness, chunk=16):
     """Brute force of the single-scattering GGX BRDF (F = 1, height-correlated Smith: Cycles' Glossy GGX)
     over the image's texels: int L(l) f_ss(l, v) (n.l) dl, n and v (K, 3) unit in the image frame.
     Point-sampling texel centres: meaningful where the lobe spans several texels (alpha >~ 4 x texel)."""
-    from ...core.conventions import ALPHA_MIN
-    from ...core.microfacet import ggx_brdf
-
     dirs, wts, rad = quad
     alpha = max(float(roughness) ** 2, ALPHA_MIN)
     out = np.empty((len(n), 3))

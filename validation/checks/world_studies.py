@@ -8,6 +8,10 @@ import numpy as np
 
 from ..harness import metrics
 from . import world_cases as vw
+from ...core import indirect
+from ...core.environment import equirect
+from ...core.environment import prefilter
+from ...core.materials import world_shading as world_term
 
 
 ERR_VMAX = 0.2
@@ -90,8 +94,6 @@ def _cod_values(spec, tables, coeffs, quad, ni, vi, roughness, node, wrap=None):
     """One CoD sphere's pixels: the SH-LTC lobe and the magnitude-only baseline (numpy float64), the node
     render's values, and the brute-force references under the SH environment and under the image; ``wrap``: the
     multiscattering wrapped diffuse's (None: the CoD diffuse)."""
-    from ...core import indirect
-
     r = np.full(len(ni), roughness)
     white = np.ones(3)
     s = spec.strength
@@ -159,8 +161,6 @@ def ggx_study(spec, image, variants, block, scene, passes, a, truth, closures, a
     own approximation (the exact split sum E(N.V) P(dominant direction), P the brute-force prefilter
     integral over the same texels, vs the integral) and the stored levels' lookup (a vs that exact
     split sum: 128 x 64 levels, bilinear, linear between roughness levels)."""
-    from ...core.environment import equirect
-
     if args.ggx_pixels <= 0:
         return None
     R = vw.euler_xyz_matrix(spec.rotation)
@@ -184,9 +184,6 @@ def ggx_study(spec, image, variants, block, scene, passes, a, truth, closures, a
 def _ggx_row(spec, tables, quad, small, ni, vi, roughness, node, cycles, args):
     """One ggx sphere's pixels: the split sum (a), the exact split sum and Cycles (``cycles``, None
     without a truth) vs the brute-force GGX integral, and (a) vs the exact split sum."""
-    from ...core.environment import prefilter
-    from ...core.materials import world_shading as world_term
-
     ref = spec.strength * vw.ggx_reference_image(quad, ni, vi, roughness)
     mu = np.clip(np.sum(ni * vi, axis=-1), 0.0, 1.0)
     scale_a, bias_b = tables.split_sum(mu, np.full(len(mu), roughness))

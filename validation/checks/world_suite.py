@@ -67,6 +67,8 @@ from . import world_cases as vw
 from .world_report import gated_checks, html_page, markdown_tables
 from .world_run import run_furnace, run_world
 from .world_studies import pool_with_front
+from ...core.environment import equirect
+from ...core.lut import lookup
 
 
 DEFAULTS = {"ab_tol": 1e-4, "ab_atol": 1e-6, "furnace_tol": 0.005, "floor": 0.1, "floor_wide": 0.01,
@@ -134,8 +136,6 @@ def _fill_defaults(args):
 
 
 def worlds_of(args):
-    from ...core.environment import equirect
-
     if args.quick and not args.hdri:
         name, rot, s = QUICK
         return [vw.WorldSpec(f"{name}_rotated", str(equirect.resolve_hdri(name)), rot, s, hdri=name)]
@@ -153,8 +153,6 @@ def worlds_of(args):
 def run(args, log=print):
     """The whole validation: every world, the furnace, the pooled errors, the gates; writes report.md,
     report.json and report.html into ``--out`` and returns the result."""
-    from ...core.lut import lookup
-
     t_start = time.perf_counter()
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)

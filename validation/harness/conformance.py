@@ -17,6 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from . import engines, grids
+from ...core.ir.numpy_backend import evaluate
+from ...core.lut.lookup import LutSet
+from .render_setup import blacken_world
+from .render_setup import configure_cycles_measurement, configure_eevee_measurement
 
 
 LAST_RENDER_SECONDS = [0.0]
@@ -35,8 +39,6 @@ def _image(bpy, name, rgb):
 
 
 def _setup_render(scene, w, h, path, engine="CYCLES"):
-    from .render_setup import configure_cycles_measurement, configure_eevee_measurement
-
     if engine == "CYCLES":
         configure_cycles_measurement(scene, samples=1, seed=0)
         scene.cycles.max_bounces = 0
@@ -198,7 +200,6 @@ def _build_plane_and_camera(bpy, scene, mat, h, w, created):
 def _build_black_world(bpy, scene, created):
     """A black world (colour and any Background node at 0), made the scene's world."""
     from ...addon import compat
-    from .render_setup import blacken_world
 
     world = compat.new_world("RTL_conformance_world")
     created["worlds"].append(world)
@@ -284,8 +285,6 @@ def check_function(function, values, tables=None, rtol=RTOL, atol=ATOL):
     ``tables`` (a table set; default the shipped LUTs).
     Returns {output: (max rel, max abs near zero, seconds)}; asserts finiteness and tolerances."""
     from ...addon.node_emit import ensure_function_group
-    from ...core.ir.numpy_backend import evaluate
-    from ...core.lut.lookup import LutSet
 
     tables = tables if tables is not None else LutSet.from_folder()
     fn = function.function

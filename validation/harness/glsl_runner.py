@@ -19,6 +19,8 @@ import numpy as np
 
 from ...core.ir.expr import FLOAT
 from . import grids
+from ...core.ir import shader_text
+from ...core.ir.numpy_backend import evaluate
 
 _STATE = {}
 MAX_TARGETS = 8
@@ -282,9 +284,6 @@ def compare_function(function, values, tables=None, runner=None, precise=True):
     """Emit ``function`` (a NodeFunction or expr.Function) as GLSL 4.50, evaluate it per texel on the GPU
     and with the numpy backend (float32 and float64) for ``values`` (input name -> (H, W) or (H, W, 3)),
     reading ``tables``.  Returns {output: Conformance}."""
-    from ...core.ir import shader_text
-    from ...core.ir.numpy_backend import evaluate
-
     fn = getattr(function, "function", function)
     module = shader_text.emit(fn, "glsl450", precise=precise)
     vals = {name: np.asarray(values[name], np.float32) for name, _ in fn.inputs}

@@ -13,6 +13,10 @@ import numpy as np
 
 from ...core import cloth, diffuse, falloff, fresnel, microfacet, multiscatter, rough_diffuse
 from ...core.conventions import alpha_from_roughness
+from ...core import lights
+from ...core.environment import equirect
+from ...core.ir import Graph
+from ...core.ir.expr import OPS, topological_order
 
 #: Side of the square per-texel grids (one render pixel per texel).
 SIZE = 48
@@ -172,9 +176,6 @@ def ir_operation_inputs(size=64):
 def ir_operation_graph():
     """One output per IR operation (every entry of ``expr.OPS`` but the table reads), inputs a, b (float)
     and u, v (vector): {output name -> Expr}."""
-    from ...core.ir import Graph
-    from ...core.ir.expr import OPS, topological_order
-
     g = Graph()
     a, b, u, v = g.input("a"), g.input("b"), g.input("u", "vector"), g.input("v", "vector")
     binary = ("add", "subtract", "multiply", "divide", "power", "minimum", "maximum", "less_than", "greater_than",
@@ -262,8 +263,6 @@ def smooth_environment(height=16, width=32):
     (L H, W, 4), rows in Blender order (row 0 at the bottom), alpha 1.  Unlike ``random_environment``, a
     one-ulp difference in the direction-to-texel mapping (arccosine, atan2) moves its lookups by about
     one ulp, not by the contrast between two random texels."""
-    from ...core.environment import equirect
-
     d = equirect.texel_directions(height, width)                       # top row first
     levels = [np.stack([1.5 + d[..., 0] * (1.0 - k / 10), 1.2 + 0.5 * d[..., 2], 1.0 + 0.3 * d[..., 1]], -1)
               for k in range(len(ENVIRONMENT_LEVELS))]
@@ -370,8 +369,6 @@ def light_data_inputs(function, size=SIZE, seed=17):
 def material_inputs(material, size=SIZE, seed=21):
     """Per-texel inputs of a whole RT Lit material (``core.materials.rt_lit.RtLitMaterial``): surface
     inputs, points on the unit sphere seen from outside, every light's driver values, the world's."""
-    from ...core import lights
-
     rng = np.random.default_rng(seed)
     shape = (size, size)
     vals = surface_inputs({n: s for n, s in material.function.sockets[0].items() if n in material.material_inputs},

@@ -3,6 +3,8 @@ optionally a studio HDRI world (rotated by a Mapping node) for the World term.""
 from __future__ import annotations
 
 import numpy as np
+from ...core.materials import rt_lit
+from ...core.materials.rt_lit_interface import Features
 
 LIGHTS = (
     # name, type, shape, location, energy, size, size_y, extra
@@ -90,8 +92,6 @@ def numpy_radiance(scene, passes, tables):
     from ...addon import light_model, materials
     from ...addon import world_sync as rtl_world
     from ...addon.common import FEATURES_KEY
-    from ...core.materials import rt_lit
-    from ...core.materials.rt_lit_interface import Features
     from .engines import camera_incoming
 
     pos = passes["Position"].astype(np.float64)
