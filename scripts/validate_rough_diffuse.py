@@ -9,13 +9,11 @@ Entry point of ``rt_lookdev.validation.checks.rough_diffuse_furnace``; ``--help`
 import sys
 
 from rt_lookdev.validation.checks import rough_diffuse_furnace
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    if "--" in argv:                      # blender --background --python x.py -- args
-        argv = argv[argv.index("--") + 1:]
-    res = rough_diffuse_furnace.run_args(rough_diffuse_furnace.parse_args(argv))
-    return 0 if all("cycles" in c["best"] for c in res["cases"]) else 1
+    return entry.main(rough_diffuse_furnace, argv, progress=print)
 
 
 if __name__ == "__main__":

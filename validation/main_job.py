@@ -254,9 +254,9 @@ def step_render(out_dir, lut_dir, resolution, samples, log=entry.flush_log):
     log("[5/13] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
-    result = validate_energy.run(out_dir=out_dir / "energy_render", lut_dir=lut_dir,
+    result = validate_energy.measure(out_dir=out_dir / "energy_render", lut_dir=lut_dir,
                                  log=lambda line: log("      " + line), **options)
-    result["summary_markdown"] = "```\n" + validate_energy.format_table(result) + "\n```"
+    result["summary_markdown"] = validate_energy.to_markdown(result)
     return result
 
 

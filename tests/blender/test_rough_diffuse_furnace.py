@@ -23,7 +23,7 @@ def test_furnace_identifies_cycles_rough_diffuse(empty_scene, tmp_path):
     from rt_lookdev.validation.checks import rough_diffuse_furnace as furnace
 
     cases = (("diffuse rho=1 sigma=1", "diffuse", 1.0, 1.0), ("principled rho=0.5 sigma=1", "principled", 0.5, 1.0))
-    res = furnace.run(cases, resolution=40, samples=16, out_dir=tmp_path, log=lambda s: None)
+    res = furnace.measure(cases, resolution=40, samples=16, out_dir=tmp_path, log=lambda s: None)
     white, grey = res["cases"]
     for row in white["bins"]:
         assert row["rendered"] == pytest.approx(1.0, abs=4 * row["se"] + 5e-4)

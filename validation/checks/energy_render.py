@@ -23,7 +23,7 @@ Usage (plain Python with the bpy module, or inside Blender):
     python scripts/validate_energy.py [--resolution N] [--samples S] [--roughness 0.25 0.5 ...]
                                       [--out DIR] [--lut-dir DIR]
     blender --background --python scripts/validate_energy.py -- [same options]
-``run(...)`` is the entry point for other scripts; it resets the open file with
+``measure(...)`` is the entry point for other code (``run(args, progress)`` the entry signature's); it resets the open file with
 ``read_homefile(use_empty=True)`` (never ``read_factory_settings``, which disables extensions).
 """
 from __future__ import annotations
@@ -331,8 +331,8 @@ def energy_tables(lut_dir):
     return LutSet.from_folder(lut_dir), str(lut_dir)
 
 
-def run(resolution=256, samples=256, roughness=(0.25, 0.5, 0.75, 1.0), out_dir=None, lut_dir=None,
-        seeds=(0, 1), threads=2, segments=256, rings=128, exact=True, keep_exr=True, log=print):
+def measure(resolution=256, samples=256, roughness=(0.25, 0.5, 0.75, 1.0), out_dir=None, lut_dir=None,
+            seeds=(0, 1), threads=2, segments=256, rings=128, exact=True, keep_exr=True, log=print):
     """Render and analyse; returns a JSON-serialisable dict (also written to out_dir)."""
     t_start = time.perf_counter()
     roughness = [float(r) for r in roughness]
@@ -439,7 +439,13 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run_args(args, log=print):
-    """``run`` with the options of ``parse_args``; returns its results (``"passed"``)."""
-    return run(args.resolution, args.samples, args.roughness, args.out, args.lut_dir, threads=args.threads,
-               segments=args.segments, rings=args.rings, exact=not args.no_exact, log=log)
+def run(args, progress=print):
+    """The entry signature (validation/harness/entry.py): ``measure`` with the options of ``parse_args``; its
+    results (``"passed"``)."""
+    return measure(args.resolution, args.samples, args.roughness, args.out, args.lut_dir, threads=args.threads,
+                   segments=args.segments, rings=args.rings, exact=not args.no_exact, log=progress)
+
+
+def to_markdown(result):
+    """``format_table`` as a Markdown code block (the main job's report)."""
+    return "```\n" + format_table(result) + "\n```"

@@ -247,7 +247,7 @@ def run_furnace(args, out_dir, log=print):
     folder = out_dir / "furnace"
     roughness = (0.25, 0.5, 0.75, 1.0)
     t0 = time.perf_counter()
-    energy = ve.run(resolution=args.furnace_cell, samples=args.furnace_samples, roughness=roughness,
+    energy = ve.measure(resolution=args.furnace_cell, samples=args.furnace_samples, roughness=roughness,
                     out_dir=folder, lut_dir=args.lut_dir, seeds=tuple(args.seeds), threads=args.threads,
                     exact=False, log=lambda s: None)
     t_energy = time.perf_counter() - t0
