@@ -31,22 +31,11 @@ from dataclasses import dataclass, field
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, PRINCIPLED_SHEEN, RT_LIT_INPUTS, SHEEN_MODELS,
-                                               SPECULAR_MODELS, Features)
+from ..core.materials.principled_mapping import (LINK_ONLY_INPUTS, MAPPED_INPUTS, RT_LIT_ONLY_INPUTS, converted_value,
+                                                values_equal)
+from ..core.materials.rt_lit_interface import DIFFUSE_MODELS, PRINCIPLED_SHEEN, SHEEN_MODELS, SPECULAR_MODELS, Features
 from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, connect_engine_outputs, not_a_light, restore_emission_sampling,
                      restore_engine_outputs)
-
-#: Principled BSDF input -> RT Lit input (same names).  "Normal" is link-only.
-MAPPED_INPUTS = (
-    "Base Color", "Metallic", "Roughness", "IOR", "Specular IOR Level", "Specular Tint",
-    "Sheen Weight", "Sheen Roughness", "Sheen Tint", "Emission Color", "Emission Strength", "Normal",
-)
-#: Principled's Diffuse Roughness (Blender 4.3+) drives RT Lit's "oren_nayar" diffuse (core/rough_diffuse.py).
-MAPPED_INPUTS += ("Diffuse Roughness",)
-#: Inputs whose value is never copied (only their link): the value is hidden and unused.
-LINK_ONLY_INPUTS = ("Normal",)
-#: RT Lit inputs with no Principled counterpart; their values are remembered on the material.
-RT_LIT_ONLY_INPUTS = tuple(name for name in RT_LIT_INPUTS if name not in MAPPED_INPUTS)
 
 EMISSION_NODE_NAME = "RT Lit Emission"
 FRAME_NODE_NAME = "RT Lit Kept Principled"
@@ -60,8 +49,6 @@ ROLE_PROP = "rtl_role"                  # "rt_lit" | "emission" | "frame" | "kep
 SAVED_LOCATION_PROP = "rtl_location"    # kept Principled: where it stood (absolute)
 SAVED_PARENT_PROP = "rtl_parent"        # kept Principled: its frame before ("" = none)
 SAVED_HIDE_PROP = "rtl_hide"            # kept Principled: was it collapsed
-
-FLOAT_TOLERANCE = 1e-6
 
 SPECULAR_LABELS = {
     "single": ("Single Scattering", "GGX single scattering only (loses energy at high roughness)"),
@@ -203,15 +190,7 @@ def _copy_value(src, dst):
     """Copy ``src``'s default value to ``dst`` (float, colour or vector; sizes adapted)."""
     if not hasattr(src, "default_value") or not hasattr(dst, "default_value"):
         return
-    value = _value(src)
-    target = _value(dst)
-    if isinstance(target, tuple):
-        if not isinstance(value, tuple):
-            value = (value,) * len(target)
-        value = tuple(value[:len(target)]) + tuple(target[len(value):])
-    elif isinstance(value, tuple):
-        value = sum(value[:3]) / min(len(value), 3)
-    dst.default_value = value
+    dst.default_value = converted_value(_value(src), _value(dst))
 
 
 def _relink(tree, src_input, dst_input):
@@ -271,15 +250,6 @@ def _transfer(tree, src_node, dst_node, names):
         _move_drivers(tree, src, dst)
 
 
-def _equal(a, b):
-    if isinstance(a, tuple) or isinstance(b, tuple):
-        a, b = tuple(a) if isinstance(a, tuple) else (a,), tuple(b) if isinstance(b, tuple) else (b,)
-        return len(a) == len(b) and all(abs(x - y) <= FLOAT_TOLERANCE for x, y in zip(a, b))
-    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        return abs(a - b) <= FLOAT_TOLERANCE
-    return a == b
-
-
 _principled_defaults: dict[str, object] = {}
 
 
@@ -308,7 +278,7 @@ def ignored_principled_inputs(node):
         if socket.is_linked:
             ignored.append(socket.name)
         elif hasattr(socket, "default_value") and socket.identifier in defaults \
-                and not socket.hide_value and not _equal(_value(socket), defaults[socket.identifier]):
+                and not socket.hide_value and not values_equal(_value(socket), defaults[socket.identifier]):
             ignored.append(socket.name)
     return tuple(ignored)
 
