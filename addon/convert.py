@@ -34,8 +34,8 @@ from bpy.props import BoolProperty, EnumProperty
 from ..core.materials.principled_mapping import (LINK_ONLY_INPUTS, MAPPED_INPUTS, RT_LIT_ONLY_INPUTS, converted_value,
                                                 values_equal)
 from ..core.materials.rt_lit_interface import DIFFUSE_MODELS, PRINCIPLED_SHEEN, SHEEN_MODELS, SPECULAR_MODELS, Features
-from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, connect_engine_outputs, not_a_light, restore_emission_sampling,
-                     restore_engine_outputs)
+from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, active_output, connect_engine_outputs, not_a_light,
+                     restore_emission_sampling, restore_engine_outputs, socket_value, source_node)
 
 EMISSION_NODE_NAME = "RT Lit Emission"
 FRAME_NODE_NAME = "RT Lit Kept Principled"
@@ -112,38 +112,6 @@ def _nodes_with_role(tree, role):
     return [n for n in tree.nodes if _role(n) == role]
 
 
-def _active_output(tree):
-    """The active Material Output (the one for all render engines first), or None."""
-    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
-    if not outputs:
-        return None
-    try:
-        node = tree.get_output_node('ALL')
-    except (AttributeError, TypeError):
-        node = None
-    if node is not None:
-        return node
-    active = [n for n in outputs if n.is_active_output]
-    for target in ('ALL', 'EEVEE', 'CYCLES'):
-        for n in active:
-            if n.target == target:
-                return n
-    return active[0] if active else outputs[0]
-
-
-def _source_node(socket):
-    """The node feeding ``socket`` (following reroutes), or None."""
-    seen = set()
-    while socket.is_linked:
-        link = socket.links[0]
-        node = link.from_node
-        if node.bl_idname != "NodeReroute" or node.name in seen:
-            return node
-        seen.add(node.name)
-        socket = node.inputs[0]
-    return None
-
-
 def _is_rt_lit_node(node):
     return node is not None and node.bl_idname == "ShaderNodeGroup" and (
         _role(node) == "rt_lit" or node.name == RT_LIT_NODE_NAME)
@@ -151,9 +119,9 @@ def _is_rt_lit_node(node):
 
 def _rt_lit_feeding(output):
     """The RT Lit node feeding the output's Surface (directly or through an Emission), or None."""
-    node = _source_node(output.inputs["Surface"])
+    node = source_node(output.inputs["Surface"])
     if node is not None and node.bl_idname == "ShaderNodeEmission":
-        node = _source_node(node.inputs["Color"])
+        node = source_node(node.inputs["Color"])
     return node if _is_rt_lit_node(node) else None
 
 
@@ -163,7 +131,7 @@ def find_rt_lit_node(material):
     tree = material.node_tree
     if tree is None:
         return None
-    output = _active_output(tree)
+    output = active_output(tree)
     node = _rt_lit_feeding(output) if output is not None else None
     if node is not None:
         return node
@@ -178,19 +146,11 @@ def is_rt_lit_material(material):
     return material is not None and find_rt_lit_node(material) is not None
 
 
-def _value(socket):
-    value = socket.default_value
-    try:
-        return tuple(value)
-    except TypeError:
-        return value
-
-
 def _copy_value(src, dst):
     """Copy ``src``'s default value to ``dst`` (float, colour or vector; sizes adapted)."""
     if not hasattr(src, "default_value") or not hasattr(dst, "default_value"):
         return
-    dst.default_value = converted_value(_value(src), _value(dst))
+    dst.default_value = converted_value(socket_value(src), socket_value(dst))
 
 
 def _relink(tree, src_input, dst_input):
@@ -230,7 +190,7 @@ def _move_drivers(tree, src, dst):
     """Move the drivers of ``src``'s value onto ``dst``'s (a driven Principled input stays driven in RT Lit
     and back); a driver on a component ``dst`` lacks is dropped."""
     for fc in _socket_drivers(tree, src):
-        size = len(_value(dst)) if isinstance(_value(dst), tuple) else 0
+        size = len(socket_value(dst)) if isinstance(socket_value(dst), tuple) else 0
         if size and fc.array_index >= size:
             continue
         new = dst.driver_add("default_value", fc.array_index) if size else dst.driver_add("default_value")
@@ -261,7 +221,7 @@ def principled_defaults():
             node = group.nodes.new("ShaderNodeBsdfPrincipled")
             for socket in node.inputs:
                 if hasattr(socket, "default_value"):
-                    _principled_defaults[socket.identifier] = _value(socket)
+                    _principled_defaults[socket.identifier] = socket_value(socket)
         finally:
             bpy.data.node_groups.remove(group)
     return _principled_defaults
@@ -278,7 +238,7 @@ def ignored_principled_inputs(node):
         if socket.is_linked:
             ignored.append(socket.name)
         elif hasattr(socket, "default_value") and socket.identifier in defaults \
-                and not socket.hide_value and not values_equal(_value(socket), defaults[socket.identifier]):
+                and not socket.hide_value and not values_equal(socket_value(socket), defaults[socket.identifier]):
             ignored.append(socket.name)
     return tuple(ignored)
 
@@ -312,8 +272,8 @@ def _principled_input_used(material, name):
     (False without such a node or input)."""
     if material is None or material.node_tree is None:
         return False
-    output = _active_output(material.node_tree)
-    node = _source_node(output.inputs["Surface"]) if output is not None else None
+    output = active_output(material.node_tree)
+    node = source_node(output.inputs["Surface"]) if output is not None else None
     if node is None or node.bl_idname != "ShaderNodeBsdfPrincipled" or node.inputs.get(name) is None:
         return False
     socket = node.inputs[name]
@@ -353,7 +313,7 @@ def _check_editable(material):
                               "(Object > Relations > Make Local) or convert it in its own file")
     if material.node_tree is None:
         raise ConversionError(f"Material '{material.name}' has no node tree (it does not use nodes)")
-    output = _active_output(material.node_tree)
+    output = active_output(material.node_tree)
     if output is None:
         raise ConversionError(f"Material '{material.name}' has no Material Output node")
     return material.node_tree, output
@@ -367,7 +327,7 @@ def _swap_group(tree, rt, group):
     """Point ``rt`` at ``group``, keeping its input values and links (by name)."""
     if rt.node_tree == group:
         return False
-    values = {s.name: _value(s) for s in rt.inputs if hasattr(s, "default_value")}
+    values = {s.name: socket_value(s) for s in rt.inputs if hasattr(s, "default_value")}
     links = {s.name: [(l.from_socket, l.is_muted) for l in s.links] for s in rt.inputs}
     rt.node_tree = group
     for socket in rt.inputs:
@@ -441,7 +401,7 @@ def principled_to_rt_lit(material, group_factory, features=None):
         rt.label = f"RT Lit ({features.label()})"
         return ConversionResult(material.name, "updated" if changed else "unchanged", features=features)
 
-    principled = _source_node(output.inputs["Surface"])
+    principled = source_node(output.inputs["Surface"])
     if principled is None or principled.bl_idname != "ShaderNodeBsdfPrincipled":
         found = "nothing" if principled is None else f"'{principled.name}' ({principled.bl_label})"
         raise ConversionError(
@@ -579,7 +539,7 @@ def rt_lit_to_principled(material):
         if socket is None:
             continue
         if hasattr(socket, "default_value"):
-            remembered[name] = _value(socket)
+            remembered[name] = socket_value(socket)
         if socket.is_linked:
             dropped.append(name)
     if remembered:

@@ -105,7 +105,7 @@ def _principled_material(bpy, name="Lookdev", *, subsurface=SUBSURFACE_WEIGHT):
     return mat
 
 
-from rt_lookdev.addon.convert import _value  # noqa: E402  (the same reading as the module under test)
+from rt_lookdev.addon.common import socket_value as _value  # noqa: E402  (the same reading as the module under test)
 
 
 def _close(a, b, tol=1e-6):
