@@ -38,6 +38,7 @@ from ..core.materials.principled_mapping import (LINK_ONLY_INPUTS, MAPPED_INPUTS
 from ..core.materials.rt_lit_interface import PRINCIPLED_SHEEN, Features
 from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, active_output, connect_engine_outputs, not_a_light,
                      restore_emission_sampling, restore_engine_outputs, socket_value, source_node)
+from .materials import ensure_rt_lit_group
 
 EMISSION_NODE_NAME = "RT Lit Emission"
 FRAME_NODE_NAME = "RT Lit Kept Principled"
@@ -452,7 +453,8 @@ def principled_to_rt_lit(material, group_factory, features=None):
 # RT Lit -> Principled
 
 
-def _kept_principled(tree):
+def kept_principled(tree):
+    """The Principled BSDF a conversion kept in ``tree`` (tagged, or in the kept-frame), or None."""
     kept = [n for n in _nodes_with_role(tree, "kept_principled") if n.bl_idname == "ShaderNodeBsdfPrincipled"]
     if kept:
         return kept[0]
@@ -482,7 +484,7 @@ def rt_lit_to_principled(material):
         raise ConversionError(f"Material '{material.name}': the RT Lit node '{rt.name}' has no node group")
 
     result = ConversionResult(material.name, "converted", features=stored_features(material))
-    principled = _kept_principled(tree)
+    principled = kept_principled(tree)
     if principled is None:
         principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
         principled.location = _absolute_location(rt)
@@ -520,8 +522,5 @@ def rt_lit_to_principled(material):
 
 
 def default_group_factory(lut_dir=None):
-    """The add-on's RT Lit group factory, reading the LUTs of ``lut_dir`` (imported lazily:
-    ``.materials`` is optional here)."""
-    from .materials import ensure_rt_lit_group
-
+    """The add-on's RT Lit group factory (``materials.ensure_rt_lit_group``), reading the LUTs of ``lut_dir``."""
     return lambda features: ensure_rt_lit_group(features, lut_dir=lut_dir)

@@ -180,11 +180,7 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
             self.report({'ERROR'}, "No material to convert" + (
                 " (no selected object has a material)" if self.target == 'SELECTED' else ""))
             return {'CANCELLED'}
-        try:
-            factory = convert.default_group_factory(preferences.lut_directory(context))
-        except ImportError as ex:
-            self.report({'ERROR'}, f"The RT Lit node group is not available: {ex}")
-            return {'CANCELLED'}
+        factory = convert.default_group_factory(preferences.lut_directory(context))
         features = self.features()
         done, failures = [], []
         for material in materials:
