@@ -82,8 +82,9 @@ def talk_readings(pos, params, albedo=1.0):
     from ..core import lights
 
     loc = np.array([params["Location X"], params["Location Y"], params["Location Z"]])
-    apex, axis = lights.projector_apex(loc, 1.0, 0.0, 0.0, 0.0, params["Scale X"], params["Scale Y"], params["Size"],
-                                       params["Size Y"], params["Cone Outer"], "quad")
+    apex, axis = lights.projector_apex(loc, 1.0, 0.0, 0.0, 0.0, params["Scale X"], params["Scale Y"],
+                                       params.get("Scale Z", 1.0), params["Size"], params["Size Y"],
+                                       params["Cone Outer"], "quad")
     d = apex - pos
     dist2 = np.maximum(np.sum(d * d, -1), lights.MIN_DISTANCE ** 2)
     l = d / np.sqrt(np.sum(d * d, -1))[:, None]

@@ -86,7 +86,7 @@ def _pool(entries):
     if rel.size:
         out.update({"mean": float(rel.mean()), "median": float(np.median(rel)),
                     "p90": float(np.percentile(rel, 90)), "max": float(rel.max())})
-    noise = [e["noise"] for e in entries if e.get("noise") is not None]
+    noise = [e["noise"] for e in entries if e.get("noise") is not None and e["noise"].size]
     if noise:
         out["noise_median"] = float(np.median(np.concatenate(noise)))
         out["noise_p90"] = float(np.percentile(np.concatenate(noise), 90))
@@ -204,7 +204,7 @@ def _variant_entries(case, args, a, b, index, t):
             entry["brute_check_seconds"] = t["t_check"].get(i)
         rel, noise = _rel_values(a, c, mask, args.floor, cp)
         rel_w, _ = _rel_values(a, c, mask, args.floor_wide, cp)
-        if rel is not None:
+        if rel is not None and rel.size:
             pooled_parts.append({"technique": v.technique, "light": "+".join(case.light_kinds), "truth": v.truth,
                                  "rel": rel, "noise": noise, "rel_wide": rel_w})
         variants.append(entry)
