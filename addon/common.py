@@ -5,6 +5,8 @@
   ``core.ir.interface.Socket`` descriptions, kept when unchanged so users of a group keep their links.
 - ``add_driver``, ``add_expression_driver``: simple-expression drivers on a socket's default value, which
   Blender evaluates without Python (so they work after a reload with auto-run off).
+- ``socket_value``, ``active_output``, ``source_node``: reading a material's tree (a socket's value as a float
+  or tuple, the active Material Output, the node feeding a socket through reroutes).
 """
 from __future__ import annotations
 
@@ -51,7 +53,8 @@ __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WO
            "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
            "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "connect_engine_outputs",
            "restore_engine_outputs", "not_a_light", "restore_emission_sampling",
-           "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "add_expression_driver"]
+           "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "add_expression_driver",
+           "socket_value", "active_output", "source_node"]
 
 SOCKET_TYPES = {"float": "NodeSocketFloat", "vector": "NodeSocketVector", "color": "NodeSocketColor",
                 "shader": "NodeSocketShader", FLOAT: "NodeSocketFloat", VECTOR: "NodeSocketVector"}
@@ -232,3 +235,44 @@ def restore_emission_sampling(material):
     if saved is not None:
         material.cycles.emission_sampling = saved
         del material[SAVED_EMISSION_SAMPLING_KEY]
+
+
+def socket_value(socket):
+    """``socket.default_value`` as a float or a tuple (a colour or a vector)."""
+    value = socket.default_value
+    try:
+        return tuple(value)
+    except TypeError:
+        return value
+
+
+def active_output(tree):
+    """The active Material Output of a material's tree (the one for all render engines first), or None."""
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    if not outputs:
+        return None
+    try:
+        node = tree.get_output_node('ALL')
+    except (AttributeError, TypeError):
+        node = None
+    if node is not None:
+        return node
+    active = [n for n in outputs if n.is_active_output]
+    for target in ('ALL', 'EEVEE', 'CYCLES'):
+        for n in active:
+            if n.target == target:
+                return n
+    return active[0] if active else outputs[0]
+
+
+def source_node(socket):
+    """The node feeding the input ``socket`` (following reroutes), or None."""
+    seen = set()
+    while socket.is_linked:
+        link = socket.links[0]
+        node = link.from_node
+        if node.bl_idname != "NodeReroute" or node.name in seen:
+            return node
+        seen.add(node.name)
+        socket = node.inputs[0]
+    return None

@@ -19,7 +19,7 @@ class RTL_PT_material(_PropertiesPanel, bpy.types.Panel):
         return context.material is not None
 
     def draw(self, context):
-        from . import convert
+        from . import convert, convert_ui
         from .common import FEATURES_KEY
 
         layout = self.layout
@@ -28,7 +28,7 @@ class RTL_PT_material(_PropertiesPanel, bpy.types.Panel):
         if convert.is_rt_lit_material(mat):
             switches = getattr(mat, "rtl_switches", None)
             if switches is not None:          # editing a switch rebuilds the group (addon/switches.py)
-                convert.draw_switches(col, switches)
+                convert_ui.draw_switches(col, switches)
             else:
                 col.label(text="RT Lit: " + ", ".join(f"{k} {v}" for k, v in dict(mat.get(FEATURES_KEY, {})).items()))
             col.operator("rtl.convert_to_principled", icon='MATERIAL')
