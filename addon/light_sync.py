@@ -164,7 +164,8 @@ class Updates:
     to walk in Python), so the kinds come from ``id_type_updated`` and the moved objects from the entries' flags
     (``foreach_get``)."""
 
-    #: Up to this many moved objects are looked up one by one (each lookup walks the entries in C); more, in one walk.
+    #: Up to this many entries are walked in Python, and up to this many moved objects looked up one by one (each
+    #: lookup walks the entries in C); more, in one walk.
     LOOKUPS = 32
 
     def __init__(self, depsgraph):
@@ -176,21 +177,37 @@ class Updates:
         # the kinds of datablock that can change which lights a scene shades and what they reach, or assign a preset
         self.relevant = self.collections or self.scene or self.objects or self.lights or updated('MATERIAL')
         self._depsgraph = depsgraph
+        self._changed = None
 
     def moved(self):
         """The objects whose transform or geometry this update changed (originals)."""
-        updates = self._depsgraph.updates
-        changed = np.zeros(len(updates), bool)
-        geometry = np.zeros(len(changed), bool)
-        updates.foreach_get("is_updated_transform", changed)
-        updates.foreach_get("is_updated_geometry", geometry)
-        changed |= geometry
-        found = np.flatnonzero(changed)
-        if len(found) <= self.LOOKUPS:
-            blocks = [updates[int(i)].id for i in found]
-        else:
-            blocks = [update.id for update, flag in zip(updates, changed) if flag]
-        return [block.original for block in blocks if isinstance(block, bpy.types.Object)]
+        return self._scan()[0]
+
+    def light_data(self):
+        """The pointers of the light data whose transform or geometry this update changed (a light's data edited: its
+        power, shape, controls)."""
+        return self._scan()[1]
+
+    def _scan(self):
+        """The entries with a transform or geometry change, read once: (objects, light data pointers)."""
+        if self._changed is None:
+            updates = self._depsgraph.updates
+            count = len(updates)
+            if count <= self.LOOKUPS:             # a few entries: walked once
+                blocks = [u.id for u in updates if u.is_updated_transform or u.is_updated_geometry]
+            else:
+                changed, geometry = np.zeros(count, bool), np.zeros(count, bool)
+                updates.foreach_get("is_updated_transform", changed)
+                updates.foreach_get("is_updated_geometry", geometry)
+                changed |= geometry
+                found = np.flatnonzero(changed)
+                if len(found) <= self.LOOKUPS:
+                    blocks = [updates[int(i)].id for i in found]
+                else:
+                    blocks = [update.id for update, flag in zip(updates, changed) if flag]
+            self._changed = ([block.original for block in blocks if isinstance(block, bpy.types.Object)],
+                             {block.original.as_pointer() for block in blocks if isinstance(block, bpy.types.Light)})
+        return self._changed
 
 
 def _state(scene, updates=None):
@@ -216,7 +233,8 @@ class _SceneState:
         self.count = len(records)
         self.signature = materials.light_signature(records)
         self.layout = materials.render_layout(scene)
-        self.lights = [(i, entry, obj) for i, ((obj, _), entry) in enumerate(zip(records, self.signature))]
+        self.lights = {obj.as_pointer(): (i, entry, obj, obj.name)
+                       for i, ((obj, _), entry) in enumerate(zip(records, self.signature))}
         self.ranged = {i: (loc, r) for i, loc, r in materials.ranged_lights(records)}
         self.spheres = None
         if self.ranged:
@@ -230,9 +248,8 @@ class _SceneState:
         if updates.collections or (updates.scene and materials.render_layout(scene) != self.layout):
             return False
         try:
-            if updates.objects or updates.lights:      # the shaded lights, each time: a few, and renames have no flag
-                if not all(self._follow_light(light) for light in self.lights):
-                    return False
+            if (updates.objects or updates.lights) and not self._follow_lights(updates):
+                return False
             if self.spheres is not None and updates.objects:
                 for obj in updates.moved():    # one not rendered stays so while the render's collections are the same
                     pointer = obj.as_pointer()
@@ -243,8 +260,19 @@ class _SceneState:
             return False
         return True
 
+    def _follow_lights(self, updates):
+        """Re-read the shaded lights: with a ranged light (the update's changes are read anyway) those whose object or
+        data this update changed, and the names (a rename has no flag); else all of them (a few)."""
+        if self.spheres is None:
+            return all(self._follow_light(light) for light in self.lights.values())
+        if any(obj.name != name for _, _, obj, name in self.lights.values()):
+            return False
+        moved, data = {obj.as_pointer() for obj in updates.moved()}, updates.light_data()
+        return all(self._follow_light(light) for pointer, light in self.lights.items()
+                   if pointer in moved or light[2].data.as_pointer() in data)
+
     def _follow_light(self, light):
-        index, entry, obj = light
+        index, entry, obj, _ = light
         kind = materials.light_kind(obj)
         if kind is None or materials.light_signature([(obj, kind)])[0] != entry:
             return False                # renamed, another kind or shape: the signature changed
@@ -261,8 +289,7 @@ class _SceneState:
             return {}
         if self.beyond is None:
             ranged = [(i, loc, r) for i, (loc, r) in sorted(self.ranged.items())]
-            self.beyond = {m: materials.out_of_range(ranged, centres, radii)
-                           for m, (centres, radii) in self.spheres.arrays.items()}
+            self.beyond = materials.out_of_range(ranged, self.spheres.arrays)
         return materials.reach_of_materials(self.beyond, self.count)
 
     def out_of_sync(self):
@@ -294,8 +321,8 @@ class _Spheres:
         if old is None or row is None or row[0] != old[0]:     # other materials: arranged anew
             self._arrange()
             return True
-        for material, i in self.places[pointer]:
-            centres, radii = self.arrays[material]
+        _, _, centres, radii = self.arrays
+        for i in self.places[pointer]:
             centres[i], radii[i] = row[1], row[2]
         return True
 

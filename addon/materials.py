@@ -462,17 +462,22 @@ def reach_rows(scene, objects):
 
 
 def material_spheres(rows, places=None):
-    """{material pointer: (centres (n, 3), radii (n,))}: the spheres of ``rows`` ({object: ``reach_row``}) by material;
-    ``places``, when given, is filled with {object: [(material pointer, index of its row there)]}."""
+    """The spheres of ``rows`` ({object: ``reach_row``}) by material: (material pointers, starts, centres (n, 3), radii
+    (n,)), material k's rows from starts[k] to starts[k + 1]; ``places``, when given, is filled with {object: [its row
+    indices]}."""
     found = {}
     for obj, (used, centre, radius) in rows.items():
         for pointer in used:
-            spheres = found.setdefault(pointer, [])
+            found.setdefault(pointer, []).append((obj, centre, radius))
+    starts, centres, radii = [0], [], []
+    for spheres in found.values():
+        for obj, centre, radius in spheres:
             if places is not None:
-                places.setdefault(obj, []).append((pointer, len(spheres)))
-            spheres.append((centre, radius))
-    return {pointer: (np.array([c for c, _ in spheres], np.float64), np.array([r for _, r in spheres], np.float64))
-            for pointer, spheres in found.items()}
+                places.setdefault(obj, []).append(len(radii))
+            centres.append(centre)
+            radii.append(radius)
+        starts.append(len(radii))
+    return list(found), np.array(starts), np.array(centres, np.float64).reshape(-1, 3), np.array(radii, np.float64)
 
 
 def ranged_lights(records):
@@ -481,17 +486,23 @@ def ranged_lights(records):
             for i, (obj, kind) in enumerate(records) if "range" in core_lights.split_kind(kind)[1]]
 
 
-def out_of_range(ranged, centres, radii):
-    """The indices of the lights of ``ranged`` ([(index, location, range)]) that reach none of the spheres
-    (``centres`` (n, 3), ``radii`` (n,)): every sphere lies at or beyond the light's range."""
-    if not ranged or not len(radii):
-        return frozenset()
+def out_of_range(ranged, spheres):
+    """{material pointer: the indices of the lights of ``ranged`` ([(index, location, range)]) that reach none of its
+    spheres} (``spheres``: ``material_spheres``): every sphere of the material lies at or beyond the light's range."""
+    materials, starts, centres, radii = spheres
+    if not ranged or not materials:
+        return {m: frozenset() for m in materials}
     locations = np.array([loc for _, loc, _ in ranged], np.float64)
     ranges = np.array([r for _, _, r in ranged], np.float64)
-    offsets = centres[:, None, :] - locations[None, :, :]                                 # (spheres, lights, 3)
-    gaps = np.sqrt((offsets * offsets).sum(axis=2)) - radii[:, None]
-    beyond = (gaps >= ranges).all(axis=0)
-    return frozenset(i for (i, _, _), far in zip(ranged, beyond) if far)
+    squared = np.zeros((len(ranged), len(radii)))          # (lights, spheres): the spheres along numpy's fast axis
+    for axis in range(3):
+        offset = locations[:, axis:axis + 1] - centres[:, axis]
+        offset *= offset
+        squared += offset
+    gaps = np.sqrt(squared) - radii
+    reached = np.logical_or.reduceat(~(gaps >= ranges[:, None]), starts[:-1], axis=1)    # (lights, materials)
+    return {m: frozenset(i for (i, _, _), hit in zip(ranged, column) if not hit)
+            for m, column in zip(materials, reached.T)}
 
 
 def reach_of_materials(beyond, count):
@@ -515,8 +526,8 @@ def material_reach(scene, records):
     ranged = ranged_lights(records)
     if not ranged:
         return {}
-    spheres = material_spheres(reach_rows(scene, rendered_objects(scene)))
-    return reach_of_materials({p: out_of_range(ranged, *s) for p, s in spheres.items()}, len(records))
+    return reach_of_materials(out_of_range(ranged, material_spheres(reach_rows(scene, rendered_objects(scene)))),
+                              len(records))
 
 
 def _reach_record(reach):
