@@ -2,6 +2,7 @@
 it shades changed, and what a re-sync costs when something did.
 
     python scripts/benchmark_light_sync.py [--objects 100 1000] [--lights 10] [--repeats 200] [--runs 5]
+                                           [--before earlier.json --before-label "..."]
 
 Each scene: ``objects`` objects, of which ``lights`` are lights (quad, disk, point, spot, sun in turn) and the rest
 meshes, with three RT Lit materials (default, every technique on, single + Lambert) in turn.  Measured in one
@@ -225,11 +226,31 @@ def run(args, log=print):
         scenes.append(_median_of_runs(runs))
     result = {"lights": args.lights, "repeats": args.repeats, "runs": args.runs, "scenes": scenes,
               "blender": bpy.app.version_string}
+    if args.before is not None:
+        result["before"] = before_figures(json.loads(args.before.read_text()), args.before_label)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.with_suffix(".json").write_text(json.dumps(result, indent=1) + "\n")
     args.out.write_text(format_markdown(result))
     log(f"[light sync] -> {args.out}")
     return result
+
+
+def before_figures(before, label):
+    """What the report shows of an earlier run of this benchmark (its JSON, ``before``), e.g. on the code before a
+    change: its handler figures per scene, and ``label`` (what the code was)."""
+    return {"label": label, "runs": before["runs"], "repeats": before["repeats"],
+            "scenes": [{"objects": s["objects"], "handler_ms": s["handler_ms"], "full_check_ms": s["full_check_ms"]}
+                       for s in before["scenes"]]}
+
+
+def _handler_table(scenes):
+    lines = ["| update | " + " | ".join(f"{s['objects']} objects{ranged}" for s in scenes
+                                         for ranged in ("", ", ranged lights")) + " |",
+             "|---|" + "---|" * (2 * len(scenes))]
+    for name, label in UPDATES.items():
+        lines.append(f"| {label} | " + " | ".join(_ms(s["handler_ms"][ranges], name) for s in scenes
+                                                    for ranges in ("without_ranges", "with_ranges")) + " |")
+    return lines
 
 
 def _ms(scene_figures, key, digits=3):
@@ -246,13 +267,7 @@ def format_markdown(r):
         f"(their range in brackets), each run's the median of {r['repeats']} updates on a scene built anew.", "",
         "The handler's own time per `view_layer.update()`, for updates that change nothing it must act on (with "
         "ranges: every light but the sun has a range reaching every object, so which lights reach which material "
-        "is checked):", "",
-        "| update | " + " | ".join(f"{s['objects']} objects{ranged}" for s in r["scenes"]
-                                   for ranged in ("", ", ranged lights")) + " |",
-        "|---|" + "---|" * (2 * len(r["scenes"]))]
-    for name, label in UPDATES.items():
-        lines.append(f"| {label} | " + " | ".join(_ms(s["handler_ms"][ranges], name) for s in r["scenes"]
-                                                    for ranges in ("without_ranges", "with_ranges")) + " |")
+        "is checked):", "", *_handler_table(r["scenes"])]
     lines += ["", "| what | " + " | ".join(f"{s['objects']} objects" for s in r["scenes"]) + " |",
               "|---|" + "---|" * len(r["scenes"])]
     rows = [("`sync_if_needed(scene)` without a depsgraph (everything checked)", "full_check_ms", "without_ranges", 3),
@@ -268,6 +283,16 @@ def format_markdown(r):
         lines.append("| of which its all-or-nothing: the groups a sync changes copied, and the copies removed (of "
                      + " and ".join(f"{s['node_groups']}" for s in r["scenes"]) + " node groups in the file) | "
                      + " | ".join(_ms(s, "snapshot_ms", 1) for s in r["scenes"]) + " |")
+    before = r.get("before")
+    if before is not None:
+        lines += ["", f"Before: {before['label']} (the same benchmark; medians of {before['runs']} runs of "
+                      f"{before['repeats']} updates):", "", *_handler_table(before["scenes"]), "",
+                  "| `sync_if_needed(scene)` without a depsgraph | "
+                  + " | ".join(f"{s['objects']} objects{ranged}" for s in before["scenes"]
+                               for ranged in ("", ", ranged lights")) + " |",
+                  "|---|" + "---|" * (2 * len(before["scenes"])),
+                  "| everything checked | " + " | ".join(_ms(s["full_check_ms"], ranges) for s in before["scenes"]
+                                                       for ranges in ("without_ranges", "with_ranges")) + " |"]
     return "\n".join(lines) + "\n"
 
 
@@ -279,4 +304,7 @@ def parse_args(argv):
     p.add_argument("--runs", type=int, default=5)
     p.add_argument("--lut-dir", type=Path, default=None)
     p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks" / "light_sync.md")
+    p.add_argument("--before", type=Path, default=None,
+                   help="the JSON of an earlier run (e.g. on the code before a change), shown beside this one's")
+    p.add_argument("--before-label", default="an earlier run", help="what the earlier run measured")
     return p.parse_args(argv)
