@@ -242,6 +242,7 @@ class _SceneState:
             self.rendered = {obj.as_pointer() for obj in rendered}
             self.spheres = _Spheres(scene, rendered)
         self.beyond = None          # {material pointer: lights reaching none of its objects}, None: to compute
+        self.moved_lights = set()   # indices of the ranged lights moved since ``beyond`` was computed
 
     def follow(self, scene, updates):
         """Re-read what ``updates`` names; False when only a full check can follow them."""
@@ -280,16 +281,19 @@ class _SceneState:
             (_, loc, r), = materials.ranged_lights([(obj, kind)])
             if (loc, r) != self.ranged[index]:
                 self.ranged[index] = (loc, r)
-                self.beyond = None
+                self.moved_lights.add(index)
         return True
 
     def reach(self):
         """``materials.material_reach`` of the scene, from the followed spheres and lights."""
         if self.spheres is None:
             return {}
-        if self.beyond is None:
-            ranged = [(i, loc, r) for i, (loc, r) in sorted(self.ranged.items())]
-            self.beyond = materials.out_of_range(ranged, self.spheres.arrays)
+        if self.beyond is None or self.moved_lights:     # the moved lights' columns, or all of them
+            redo = self.ranged.keys() if self.beyond is None else self.moved_lights
+            found = materials.out_of_range([(i, *self.ranged[i]) for i in sorted(redo)], self.spheres.arrays)
+            self.beyond = found if self.beyond is None else \
+                {m: (far - self.moved_lights) | found[m] for m, far in self.beyond.items()}
+            self.moved_lights = set()
         return materials.reach_of_materials(self.beyond, self.count)
 
     def out_of_sync(self):
