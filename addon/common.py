@@ -3,8 +3,8 @@
 - Names of what the add-on stores in a .blend: groups, node names, custom properties, image prefix.
 - ``socket_by_identifier``, ``ensure_interface``: node-group interfaces built from
   ``core.ir.interface.Socket`` descriptions, kept when unchanged so users of a group keep their links.
-- ``add_driver``: a simple-expression driver (``var``) on a socket's default value, which Blender
-  evaluates without Python (so it works after a reload with auto-run off).
+- ``add_driver``, ``add_expression_driver``: simple-expression drivers on a socket's default value, which
+  Blender evaluates without Python (so they work after a reload with auto-run off).
 - ``node_groups_kept_on_error``: a rebuild of the add-on's node groups as one transaction (all or nothing).
 """
 from __future__ import annotations
@@ -27,6 +27,9 @@ LIGHTS_RECORD_KEY = "rtl_lights"
 #: Custom property of ``SCENE_LIGHTS_GROUP``: the synced lights' "<object>:<kind>:<shape>", what the
 #: automatic light sync compares (addon/light_sync.py).
 LIGHTS_SIGNATURE_KEY = "rtl_light_signature"
+#: On "RTL Scene Lights": {light name: object attribute} of the lights with light linking
+#: (addon/light_model.py ``linking_attributes``).
+LINKING_KEY = "rtl_light_linking"
 #: On a culled RT Lit group: the indices of the scene lights it shades (addon/materials.py ``cull_lights``).
 LIGHTS_SUBSET_KEY = "rtl_lights_subset"
 #: On "RTL Scene Lights": the lights that reach each RT Lit material, as last culled.
@@ -47,11 +50,12 @@ ADDED_OUTPUT_KEY = "rtl_added_output"
 SAVED_EMISSION_SAMPLING_KEY = "rtl_saved_emission_sampling"
 
 __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WORLD_GROUP", "FEATURES_KEY",
-           "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "LIGHTS_SIGNATURE_KEY", "LIGHTS_SUBSET_KEY", "REACH_KEY",
+           "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "LINKING_KEY", "LIGHTS_SIGNATURE_KEY", "LIGHTS_SUBSET_KEY", "REACH_KEY",
            "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
            "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "connect_engine_outputs",
            "restore_engine_outputs", "not_a_light", "restore_emission_sampling",
-           "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "node_groups_kept_on_error", "before_rebuild"]
+           "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "add_expression_driver",
+           "node_groups_kept_on_error", "before_rebuild"]
 
 SOCKET_TYPES = {"float": "NodeSocketFloat", "vector": "NodeSocketVector", "color": "NodeSocketColor",
                 "shader": "NodeSocketShader", FLOAT: "NodeSocketFloat", VECTOR: "NodeSocketVector"}
@@ -138,26 +142,37 @@ def add_driver(socket, target_id, source, id_type=None):
     ("transform", "LOC_X" / "ROT_W" / "SCALE_Z", ...) is a TRANSFORMS variable in world space
     (quaternion rotation), ("data", path) a SINGLE_PROP variable on ``target_id`` (an ID of
     ``id_type``, e.g. "LIGHT" or "WORLD")."""
+    kind, what = source
+    return add_expression_driver(socket, "var", [("var", "transform" if kind == "transform" else id_type,
+                                                  target_id, what)])
+
+
+def add_expression_driver(socket, expression, variables):
+    """A driver ``expression`` (a simple expression: Blender evaluates it without Python) on
+    ``socket.default_value``; ``variables`` [(name, kind, ID, what)]: kind "transform" is a TRANSFORMS
+    variable in world space reading channel ``what`` ("LOC_X", "ROT_W" in quaternion mode, "SCALE_Z"),
+    any other kind a SINGLE_PROP variable on an ID of that type ("LIGHT", "OBJECT", "WORLD") reading the
+    data path ``what``."""
     fc = socket.driver_add("default_value")
     drv = fc.driver
     drv.type = "SCRIPTED"
-    drv.expression = "var"
-    var = drv.variables.new()
-    var.name = "var"
-    kind, what = source
-    target = var.targets[0]
-    if kind == "transform":
-        var.type = "TRANSFORMS"
-        target.id = target_id
-        target.transform_type = what
-        target.transform_space = "WORLD_SPACE"
-        if what.startswith("ROT_"):
-            target.rotation_mode = "QUATERNION"
-    else:
-        var.type = "SINGLE_PROP"
-        target.id_type = id_type
-        target.id = target_id
-        target.data_path = what
+    drv.expression = expression
+    for name, kind, target_id, what in variables:
+        var = drv.variables.new()
+        var.name = name
+        target = var.targets[0]
+        if kind == "transform":
+            var.type = "TRANSFORMS"
+            target.id = target_id
+            target.transform_type = what
+            target.transform_space = "WORLD_SPACE"
+            if what.startswith("ROT_"):
+                target.rotation_mode = "QUATERNION"
+        else:
+            var.type = "SINGLE_PROP"
+            target.id_type = kind
+            target.id = target_id
+            target.data_path = what
     return fc
 
 

@@ -3,8 +3,9 @@
 Each difference is named with the release where it changed (checked with the bpy wheels of each
 release, tests run by ``bash scripts/test.sh --matrix``):
 
-- 5.0: materials and worlds always have a node tree; ``use_nodes`` is deprecated (setting it False is
-  ignored).  Before 5.0 a new material or world has no node tree until ``use_nodes = True``, which
+- 5.0: materials, worlds and lights always render their node tree; ``use_nodes`` is deprecated (setting it
+  False is ignored: measured for a light with bpy 5.2.3, whose Emission strength 0.25 applied with
+  ``use_nodes`` off, while 4.5.15 then renders the light without its tree).  Before 5.0 a new material or world has no node tree until ``use_nodes = True``, which
   creates the default one (Principled BSDF + Material Output; Background + World Output).
 - 5.0: the EEVEE render engine is ``BLENDER_EEVEE`` again; 4.2 to 4.5 call it ``BLENDER_EEVEE_NEXT``.
 - 5.0: the Math node's Power of a zero base with a negative exponent gives 0 (core/ir/semantics.py's rule);
@@ -68,8 +69,9 @@ def unsupported_message(release=None):
 
 
 def ensure_node_tree(id_block):
-    """The node tree of a material or world, created (``use_nodes = True``) where the release needs it."""
-    if id_block.node_tree is None and version() < PERMANENT_NODE_TREES:
+    """The node tree of a material, world or light, created and switched on (``use_nodes = True``) where the
+    release needs it."""
+    if version() < PERMANENT_NODE_TREES and (id_block.node_tree is None or not id_block.use_nodes):
         id_block.use_nodes = True
     return id_block.node_tree
 
@@ -89,7 +91,7 @@ def new_world(name):
 
 
 def uses_nodes(id_block):
-    """Whether a material or world renders its node tree (always from 5.0)."""
+    """Whether a material, world or light renders its node tree (always from 5.0, when it has one)."""
     if version() >= PERMANENT_NODE_TREES:
         return id_block.node_tree is not None
     return bool(id_block.use_nodes) and id_block.node_tree is not None

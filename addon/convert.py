@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, RT_LIT_INPUTS, SHEEN_MODELS, SPECULAR_MODELS,
-                                               Features)
+from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, PRINCIPLED_SHEEN, RT_LIT_INPUTS, SHEEN_MODELS,
+                                               SPECULAR_MODELS, Features)
 from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, connect_engine_outputs, not_a_light, restore_emission_sampling,
                      restore_engine_outputs)
 
@@ -92,8 +92,6 @@ SHEEN_LABELS = {
     "disney_talk": ("Disney (talk)", "Disney sheen as the talk shades it: the CoD table at r = 0.5 under area lights"),
 }
 SHEEN_ITEMS = tuple((m, *SHEEN_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SHEEN_MODELS)
-#: The sheen model a conversion picks for a Principled material with sheen.
-PRINCIPLED_SHEEN = "zeltner"
 
 
 class ConversionError(ValueError):

@@ -128,7 +128,7 @@ def build_demo_scene(lut_dir=None, resolution=256, hdri=DEFAULT_HDRI, world_stre
 def parse_args(argv):
     """The options of scripts/build_demo_scene.py parsed from ``argv`` (the arguments after Blender's
     ``--`` when run inside Blender: the script strips them)."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=DEFAULT_OUT)
     parser.add_argument("--lut-dir", type=Path, default=None)
     parser.add_argument("--resolution", type=int, default=256)

@@ -69,6 +69,9 @@ PROPERTIES = {
         description="Level of detail: shade this quad light as a spot light at its projector apex, with the cone "
                     "falloff (the talk's quad-to-spot fallback): cheaper, and exact in the far field"),
 }
+#: The options of core.lights.LIGHT_OPTIONS these controls switch (the others follow Blender's own settings:
+#: addon/light_model.py).
+CONTROL_OPTIONS = ("cone", "range")
 #: The properties the drivers read (the others choose the light's kind).
 DRIVEN = ("rtl_range", "rtl_cone_inner", "rtl_cone_outer")
 
@@ -84,8 +87,7 @@ def light_kind(data, base):
     "quad_spot+range", or ``base`` itself with none on."""
     if base == "quad" and value(data, "rtl_spot_fallback"):
         base = "quad_spot"
-    options = [o for o in core_lights.LIGHT_OPTIONS
-               if value(data, f"rtl_use_{o}") and base in core_lights.OPTION_KINDS[o]]
+    options = [o for o in CONTROL_OPTIONS if value(data, f"rtl_use_{o}") and base in core_lights.OPTION_KINDS[o]]
     return core_lights.kind_name(base, options)
 
 

@@ -77,8 +77,9 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
 
 
 class RTL_OT_add_path_traced_twin(bpy.types.Operator):
-    """Add a scene that path-traces the active lookdev scene with its Principled materials: the same
-    lights, camera and world, spheres that follow the originals.  Switch scenes to compare"""
+    """Add a scene that path-traces the active scene with its Principled materials: the same lights, camera
+    and world, copies of the RT Lit objects that follow the originals, the other objects as they are.  Switch
+    scenes to compare"""
 
     bl_idname = "rtl.add_path_traced_twin"
     bl_label = "Add Path-Traced Twin"
@@ -98,7 +99,7 @@ class RTL_OT_add_path_traced_twin(bpy.types.Operator):
         if lookdev_scene.twin_of(scene) is not None:
             cls.poll_message_set("This scene is a path-traced twin; switch to its lookdev scene")
             return False
-        if not lookdev_scene.lookdev_spheres(scene):
+        if not any(lookdev_scene.uses_rt_lit(o) for o in scene.objects):
             cls.poll_message_set("The scene has no object with an RT Lit material")
             return False
         return True
@@ -110,8 +111,8 @@ class RTL_OT_add_path_traced_twin(bpy.types.Operator):
             self.report({'ERROR'}, f"Could not add the twin: {type(ex).__name__}: {ex}")
             return {'CANCELLED'}
         count = sum(1 for o in twin.objects if lookdev_scene.TWIN_SOURCE_KEY in o.keys())
-        self.report({'INFO'}, f"Path-traced twin '{twin.name}': {count} Principled objects, "
-                              f"{self.bounces} bounces, {self.samples} samples")
+        self.report({'INFO'}, f"Path-traced twin '{twin.name}': {count} objects copied with Principled materials, "
+                              f"{len(twin.objects) - count} shared, {self.bounces} bounces, {self.samples} samples")
         return {'FINISHED'}
 
 

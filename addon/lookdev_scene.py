@@ -7,13 +7,20 @@ Blender's own, baked for the World term), an orthographic camera, and render set
 Cycles with 0 bounces (RT Lit surfaces are emitters: with bounces they would light each other a second
 time), the view transform the artist picks (AgX or Standard).
 
-``add_path_traced_twin(scene)`` adds the scene's twin: a scene "<name> Path Traced" that links the same
-lights, camera and world, and holds a copy of each sphere (same mesh, transform copied from the original
-by a constraint, so moving a sphere moves its twin) whose object-level material is the Principled BSDF
-the RT Lit material was converted from, with the values edited in RT Lit (``convert.rt_lit_to_principled``
-on a copy).  It renders with Cycles path tracing, by default direct light only (0 bounces: what RT Lit
-computes, plus the shadows it does not), so switching scenes compares real-time and path-traced shading.
-``validation.lookdev_twin`` measures the two against each other.
+``add_path_traced_twin(scene)`` adds the scene's twin: a scene "<name> Path Traced" with the same world and
+camera that holds every object the scene renders.  An object with an RT Lit material in some slot is copied
+(same data and modifiers, transform copied from the original by a constraint, so moving a sphere moves its
+twin), and each such slot of the copy holds, linked to the object, the Principled BSDF the RT Lit material was
+converted from, with the values edited in RT Lit (``convert.rt_lit_to_principled`` on a copy, one per
+material); an instancer of a collection with RT Lit objects is copied to instance a twin of that collection;
+every other object (lights, camera, other materials, no material) is the object itself.  The copies join the
+light-linking collections of the lights and emitters with their originals' states, so light and shadow linking
+act on the twin as on the scene.  It renders with Cycles path tracing, by default direct light only (0 bounces:
+what RT Lit computes, plus the shadows it does not), so switching scenes compares real-time and path-traced
+shading.  ``validation.lookdev_twin`` measures the two against each other.  Not twinned: materials a modifier
+assigns (Geometry Nodes' Set Material), particle instances, and the view layers' collection settings (exclude
+aside: an object the scene does not render is left out); a light-linking collection that a scene renders cannot
+hold the copies, and the twin is refused.
 
 The lights RT Lit shades are one set per file ("RTL Scene Lights", ``materials.py``): the twin shares the
 lookdev scene's lights, so switching to it keeps the RT Lit groups in sync.
@@ -25,6 +32,7 @@ import math
 import bpy
 
 from . import compat
+from .light_model import link_states
 
 #: Sphere roughness along each row.
 ROUGHNESS = (0.05, 0.25, 0.5, 0.75, 1.0)
@@ -258,43 +266,191 @@ def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world
     return scene
 
 
-def lookdev_spheres(scene):
-    """The mesh objects of ``scene`` whose material is RT Lit, in name order."""
+def rt_lit_slots(obj):
+    """Indices of the material slots of ``obj`` whose material (as the slot links it) is RT Lit."""
     from .convert import is_rt_lit_material
 
-    return sorted((o for o in scene.objects if o.type == "MESH" and o.active_material is not None
-                   and is_rt_lit_material(o.active_material)), key=lambda o: o.name)
+    return [i for i, slot in enumerate(obj.material_slots) if is_rt_lit_material(slot.material)]
+
+
+def _instanced(obj):
+    """The collection ``obj`` instances, or None."""
+    return obj.instance_collection if obj.instance_type == "COLLECTION" else None
+
+
+def uses_rt_lit(obj, _seen=None):
+    """Whether ``obj`` renders an RT Lit material: in one of its slots, or in the collection it instances."""
+    if rt_lit_slots(obj):
+        return True
+    instanced = _instanced(obj)
+    seen = set() if _seen is None else _seen
+    if instanced is None or instanced.as_pointer() in seen:
+        return False
+    seen.add(instanced.as_pointer())
+    return any(uses_rt_lit(o, seen) for o in instanced.all_objects)
+
+
+def lookdev_spheres(scene):
+    """The objects of ``scene`` with an RT Lit material in one of their slots, in name order."""
+    return sorted((o for o in scene.objects if rt_lit_slots(o)), key=lambda o: o.name)
 
 
 # --- the path-traced twin ------------------------------------------------------------------------------
 
+#: The light-linking collections of an object (``Object.light_linking``): light linking and shadow linking.
+LINKING_COLLECTIONS = ("receiver_collection", "blocker_collection")
+
+
 def twin_material(material):
     """A Principled copy of the RT Lit ``material``: the values edited in RT Lit carried back
-    (``convert.rt_lit_to_principled`` on a copy; the original stays RT Lit)."""
+    (``convert.rt_lit_to_principled`` on a copy; the original stays RT Lit), tagged with its name."""
     from . import convert
 
     twin = material.copy()
     twin.name = material.name + TWIN_SUFFIX
-    convert.rt_lit_to_principled(twin)
+    try:
+        convert.rt_lit_to_principled(twin)
+    except Exception:
+        bpy.data.materials.remove(twin)
+        raise
     for key in list(twin.keys()):        # the copy is not an RT Lit material
         if key.startswith("rtl_"):
             del twin[key]
+    twin[TWIN_SOURCE_KEY] = material.name
     return twin
 
 
-def add_path_traced_twin(scene, bounces=0, samples=128):
-    """Add (or rebuild) the path-traced twin of the lookdev ``scene``; returns the twin scene.
+def _reachable(objects):
+    """{pointer: object} of ``objects`` and of the objects of the collections they instance, at any depth."""
+    out, todo = {}, list(objects)
+    while todo:
+        obj = todo.pop(0)
+        if obj.as_pointer() in out:
+            continue
+        out[obj.as_pointer()] = obj
+        instanced = _instanced(obj)
+        if instanced is not None:
+            todo.extend(instanced.all_objects)
+    return out
 
-    Lights, camera and world are the same objects; each RT Lit sphere gets a copy sharing its mesh, with the
-    Principled twin of its material linked to the object and its transform copied from the original."""
-    spheres = lookdev_spheres(scene)
-    if not spheres:
-        raise ValueError(f"scene '{scene.name}' has no RT Lit object to twin")
-    twin_name = scene.name + TWIN_SUFFIX
-    old = bpy.data.scenes.get(twin_name)
-    if old is not None:
-        remove_twin(old)
-    twin = bpy.data.scenes.new(twin_name)
+
+def _collection_holders():
+    """{collection pointer: what renders it, in words}: the collections of every scene and those objects
+    instance, with their children."""
+    holders = {}
+    roots = [(s.collection, f"the scene '{s.name}'") for s in bpy.data.scenes]
+    roots += [(_instanced(o), f"the instances of '{o.name}'") for o in bpy.data.objects if _instanced(o) is not None]
+    for root, holder in roots:
+        for collection in (root, *root.children_recursive):
+            holders.setdefault(collection.as_pointer(), holder)
+    return holders
+
+
+def _linking_plan(objects):
+    """[(light-linking collection, [(original, state)])]: where the copies of ``objects`` (and of the objects they
+    instance) go so that every emitter links them as their originals.  Raises ValueError when such a collection
+    cannot hold them: linked from a library, or rendered itself (the copies would show there)."""
+    reachable = _reachable(objects)
+    copied = {p for p, o in reachable.items() if uses_rt_lit(o)}
+    plan, seen, holders = [], set(), None
+    for emitter in reachable.values():
+        for attr in LINKING_COLLECTIONS:
+            collection = getattr(emitter.light_linking, attr)
+            if collection is None or collection.as_pointer() in seen:
+                continue
+            seen.add(collection.as_pointer())
+            entries = [(o, state) for p, (o, state) in link_states(collection).items() if p in copied]
+            if not entries:
+                continue
+            what = f"the light linking of '{emitter.name}' uses the collection '{collection.name}'"
+            if collection.library is not None:
+                raise ValueError(f"{what}, linked from '{collection.library.filepath}': the twin cannot add its "
+                                 "copies to it; make it local")
+            holders = _collection_holders() if holders is None else holders
+            holder = holders.get(collection.as_pointer())
+            if holder is not None:
+                raise ValueError(f"{what}, which {holder} renders: the twin's copies would appear there. Give "
+                                 f"'{emitter.name}' a light-linking collection of its own (Object Properties > "
+                                 "Shading > Light Linking)")
+            plan.append((collection, entries))
+    return plan
+
+
+class _TwinParts:
+    """The copies, collections and materials one twin is made of, each made once (``made``: every ID made,
+    with the name it is meant to have)."""
+
+    def __init__(self):
+        self.objects = {}        # original's pointer -> the object the twin renders for it (itself or its copy)
+        self.collections = {}    # pointer of a collection -> itself or its twin
+        self.materials = {}      # RT Lit material's pointer -> its Principled twin
+        self.made = []
+
+    def material(self, material):
+        key = material.as_pointer()
+        if key not in self.materials:
+            self.materials[key] = twin_material(material)
+            self.made.append((self.materials[key], material.name + TWIN_SUFFIX))
+        return self.materials[key]
+
+    def object(self, obj):
+        """``obj`` itself when it renders no RT Lit material, else its copy: sharing its data, the Principled twin
+        in each RT Lit slot (linked to the object), the twin of the collection it instances, its transform copied
+        from ``obj`` by a constraint."""
+        key = obj.as_pointer()
+        if key in self.objects:
+            return self.objects[key]
+        self.objects[key] = obj
+        slots = rt_lit_slots(obj)
+        instanced = _instanced(obj)
+        instanced_twin = self.collection(instanced) if instanced is not None else None
+        if not slots and instanced_twin == instanced:
+            return obj
+        copy = obj.copy()
+        copy.name = obj.name + TWIN_SUFFIX
+        self.made.append((copy, obj.name + TWIN_SUFFIX))
+        copy[TWIN_SOURCE_KEY] = obj.name
+        for i in slots:
+            material = obj.material_slots[i].material
+            copy.material_slots[i].link = "OBJECT"
+            copy.material_slots[i].material = self.material(material)
+        if instanced_twin != instanced:
+            copy.instance_collection = instanced_twin
+        constraint = copy.constraints.new("COPY_TRANSFORMS")
+        constraint.target = obj
+        self.objects[key] = copy
+        return copy
+
+    def collection(self, collection):
+        """``collection`` itself when none of its objects is copied, else a new collection of their twins."""
+        key = collection.as_pointer()
+        if key in self.collections:
+            return self.collections[key]
+        self.collections[key] = collection
+        objects = [self.object(o) for o in collection.objects]
+        children = [self.collection(c) for c in collection.children]
+        if objects == list(collection.objects) and children == list(collection.children):
+            return collection
+        twin = bpy.data.collections.new(collection.name + TWIN_SUFFIX)
+        self.made.append((twin, collection.name + TWIN_SUFFIX))
+        twin[TWIN_SOURCE_KEY] = collection.name
+        twin.instance_offset = collection.instance_offset
+        twin.hide_render = collection.hide_render
+        for obj in objects:
+            twin.objects.link(obj)
+        for child in children:
+            twin.children.link(child)
+        self.collections[key] = twin
+        return twin
+
+    def remove(self):
+        """Remove everything made (a twin that could not be finished)."""
+        bpy.data.batch_remove([id_block for id_block, _ in self.made])
+        self.made.clear()
+
+
+def _configure_twin(twin, scene, bounces, samples):
+    """The twin's world, camera and Cycles path tracing, with ``scene``'s resolution and view."""
     twin[TWIN_OF_KEY] = scene.name
     twin.world = scene.world
     if scene.world is not None:
@@ -308,29 +464,75 @@ def add_path_traced_twin(scene, bounces=0, samples=128):
     twin.cycles.max_bounces = int(bounces)
     twin.view_settings.view_transform = scene.view_settings.view_transform
     twin.view_settings.look = scene.view_settings.look
-    for obj in scene.objects:
-        if obj.type in ("LIGHT", "CAMERA"):
-            twin.collection.objects.link(obj)
-    for obj in spheres:
-        copy = obj.copy()                 # shares the mesh (and its RT Lit material slot)
-        copy.name = obj.name + TWIN_SUFFIX
-        copy[TWIN_SOURCE_KEY] = obj.name
-        copy.material_slots[0].link = "OBJECT"
-        copy.material_slots[0].material = twin_material(obj.active_material)
-        constraint = copy.constraints.new("COPY_TRANSFORMS")
-        constraint.target = obj
-        twin.collection.objects.link(copy)
+
+
+def add_path_traced_twin(scene, bounces=0, samples=128):
+    """Add (or rebuild) the path-traced twin of ``scene`` (the module doc); returns the twin scene.
+
+    Raises ValueError, changing nothing, when ``scene`` renders no RT Lit material or a light-linking collection
+    cannot take the copies (``_linking_plan``); a twin made before stays until the new one is whole."""
+    from .materials import is_rendered
+
+    rendered = [o for o in scene.objects if is_rendered(scene, o)]
+    if not any(uses_rt_lit(o) for o in rendered):
+        raise ValueError(f"scene '{scene.name}' renders no RT Lit material to twin")
+    plan = _linking_plan(rendered)
+    twin_name = scene.name + TWIN_SUFFIX
+    old = bpy.data.scenes.get(twin_name)
+    old = old if old is not None and TWIN_OF_KEY in old.keys() else None
+    parts = _TwinParts()
+    twin = bpy.data.scenes.new(twin_name)
+    parts.made.append((twin, twin_name))
+    try:
+        _configure_twin(twin, scene, bounces, samples)
+        for obj in rendered:
+            twin.collection.objects.link(parts.object(obj))
+        if scene.camera is not None and scene.camera.name not in twin.collection.objects:
+            twin.collection.objects.link(scene.camera)
+        for collection, entries in plan:
+            for original, state in entries:
+                copy = parts.objects[original.as_pointer()]
+                if copy != original:
+                    collection.objects.link(copy)
+                    collection.collection_objects[len(collection.objects) - 1].light_linking.link_state = state
+    except Exception:
+        parts.remove()
+        raise
+    if old is not None:
+        remove_twin(old)
+    for id_block, name in parts.made:        # the names the old twin held
+        if id_block.name != name:
+            id_block.name = name
     return twin
 
 
+def _twin_parts(collection, objects, collections):
+    """Gather the copies in ``collection`` and the twin collections they instance, at any depth."""
+    for obj in collection.objects:
+        if TWIN_SOURCE_KEY in obj.keys() and obj not in objects:
+            objects.append(obj)
+            instanced = _instanced(obj)
+            if instanced is not None and TWIN_SOURCE_KEY in instanced.keys() and instanced not in collections:
+                collections.append(instanced)
+                _twin_parts(instanced, objects, collections)
+    for child in collection.children:
+        if TWIN_SOURCE_KEY in child.keys() and child not in collections:
+            collections.append(child)
+            _twin_parts(child, objects, collections)
+
+
 def remove_twin(twin):
-    """Remove a twin scene with the objects and materials it made (lights, camera, world, meshes stay)."""
-    for obj in list(twin.objects):
-        if TWIN_SOURCE_KEY in obj.keys():
-            for slot in obj.material_slots:
-                if slot.link == "OBJECT" and slot.material is not None and slot.material.users <= 1:
-                    bpy.data.materials.remove(slot.material)
-            bpy.data.objects.remove(obj)
+    """Remove a twin scene with what it made: its copies, their instanced collections and the materials only they
+    used (what it shares stays; the copies leave the light-linking collections with them)."""
+    objects, collections = [], []
+    _twin_parts(twin.collection, objects, collections)
+    materials = {slot.material.as_pointer(): slot.material for obj in objects for slot in obj.material_slots
+                 if slot.link == "OBJECT" and slot.material is not None}
+    if objects or collections:
+        bpy.data.batch_remove([*objects, *collections])
+    unused = [m for m in materials.values() if m.users == 0]
+    if unused:
+        bpy.data.batch_remove(unused)
     bpy.data.scenes.remove(twin)
 
 

@@ -27,54 +27,17 @@ from ..core.lut.lookup import LutSet
 from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, RT_LIT_OUTPUTS,
                                                Features, light_input, rt_lit_group_name)
-from . import compat, light_controls, node_emit, world_sync
-from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LIGHTS_SIGNATURE_KEY, LIGHTS_SUBSET_KEY, REACH_KEY,
+from . import compat, light_controls, light_model, node_emit, world_sync
+from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LINKING_KEY, LIGHTS_SIGNATURE_KEY, LIGHTS_SUBSET_KEY, REACH_KEY,
                      RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP, STAMP_KEY,
-                     WORLD_GROUP, add_driver, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers,
+                     WORLD_GROUP, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers,
                      socket_by_identifier)
+from .light_model import light_kind
 
-_AREA_SHAPES = {"SQUARE": "quad", "RECTANGLE": "quad", "DISK": "disk", "ELLIPSE": "disk"}
 #: Geometry node output feeding each geometry input of the material function.
 _GEOMETRY_SOCKETS = {"Position": "Position", "Geometry Normal": "Normal", "Incoming": "Incoming"}
-
-
-def light_kind(obj):
-    """The RT Lit light kind of a light object with its controls ("quad+cone+range", addon/light_controls.py),
-    or None if RT Lit does not shade it."""
-    if obj.type != "LIGHT":
-        return None
-    data = obj.data
-    if data.type == "AREA":
-        base = _AREA_SHAPES.get(data.shape)
-    else:
-        base = {"POINT": "point", "SPOT": "spot", "SUN": "sun"}.get(data.type)
-    return None if base is None else light_controls.light_kind(data, base)
-
-
-#: Sun angles below this are shaded as 0 without a word (Blender's default sun is 0.53 degrees).
-SUN_ANGLE_REPORTED = math.radians(1.0)
-
-
-def ignored_light_settings(obj, kind):
-    """The settings of a light RT Lit does not shade (core/lights.py: radius-0 point and spot lights, an
-    angle-0 sun, no exposure, temperature or spread), as short phrases: ["radius 0.1 m", ...]."""
-    data = obj.data
-    kind = core_lights.base_kind(kind)
-    kind = "quad" if kind == "quad_spot" else kind
-    out = []
-    if abs(getattr(data, "exposure", 0.0)) > 0.0:
-        out.append(f"exposure {data.exposure:+g}")
-    if getattr(data, "use_temperature", False):
-        out.append(f"temperature {data.temperature:g} K")
-    if not getattr(data, "normalize", True):
-        out.append("Normalize off")
-    if kind in ("quad", "disk") and getattr(data, "spread", math.pi) < math.pi - 1e-6:
-        out.append(f"spread {math.degrees(data.spread):.0f} deg")
-    if kind in ("point", "spot") and data.shadow_soft_size > 0.0:
-        out.append(f"radius {data.shadow_soft_size:g} m")
-    if kind == "sun" and data.angle > SUN_ANGLE_REPORTED:
-        out.append(f"angle {math.degrees(data.angle):.1f} deg")
-    return out
+#: Driver sources that are not in "RTL Scene Lights": the linking option's per-object attribute.
+_PER_OBJECT_SOURCES = ("excluded",)
 
 
 def is_rendered(scene, obj):
@@ -107,37 +70,14 @@ def _included_collections(layer_collection, out=None):
 
 
 def scene_lights(scene):
-    """(object, kind) of every light RT Lit shades: rendered lights (``is_rendered``), in name order (the
-    sun with angle 0, point and spot lights with radius 0: see core/lights.py)."""
+    """(object, kind) of every light RT Lit shades: rendered lights (``is_rendered``), in name order
+    (``light_model.light_kind``)."""
     out = []
     for obj in sorted(scene.objects, key=lambda o: o.name):
         kind = light_kind(obj)
         if kind is not None and is_rendered(scene, obj):
             out.append((obj, kind))
     return out
-
-
-def _driver_target(obj, source):
-    """(ID, id_type) a driver of ``source`` reads: the object for transforms, its light data else."""
-    return (obj, None) if source[0] == "transform" else (obj.data, "LIGHT")
-
-
-def _static_value(obj, source):
-    """The value a driver will compute, for the Value node's initial default."""
-    kind, what = source
-    if kind == "transform":
-        loc, rot, scale = obj.matrix_world.decompose()
-        axis = "WXYZ".index(what[-1]) if what.startswith("ROT_") else "XYZ".index(what[-1])
-        if what.startswith("LOC_"):
-            return loc[axis]
-        if what.startswith("ROT_"):
-            return rot[axis]
-        return scale[axis]
-    return float(obj.data.path_resolve(what))
-
-
-def _shape(obj):
-    return obj.data.shape if obj.data.type == "AREA" else None
 
 
 def sync_scene_lights(scene):
@@ -153,7 +93,9 @@ def sync_scene_lights(scene):
     for index, (obj, kind) in enumerate(records):
         if core_lights.split_kind(kind)[1] or core_lights.base_kind(kind) == "quad_spot":
             light_controls.store_driven_values(obj.data)
-        for param, source in core_lights.driver_sources(kind, _shape(obj)).items():
+        for param, source in core_lights.driver_sources(kind, light_model.shape(obj)).items():
+            if source[0] in _PER_OBJECT_SOURCES:
+                continue
             plan.append((light_input(index, param), obj, source,
                          Socket("float", 0.0, description=f"{obj.name}: {param} ({source[0]} {source[1]})",
                                 panel=f"Light {index}: {obj.name}")))
@@ -164,19 +106,23 @@ def sync_scene_lights(scene):
         value = ng.nodes.new("ShaderNodeValue")
         value.name = value.label = name
         value.location = (0.0, -row * 90.0)
-        value.outputs[0].default_value = _static_value(obj, source)
-        target, id_type = _driver_target(obj, source)
-        add_driver(value.outputs[0], target, source, id_type)
+        value.outputs[0].default_value = light_model.static_value(obj, source)
+        light_model.add_light_driver(value.outputs[0], obj, source)
         ng.links.new(value.outputs[0], socket_by_identifier(out.inputs, items[(name, "OUTPUT")].identifier))
     out.location = (400.0, 0.0)
     ng[LIGHTS_RECORD_KEY] = [f"{obj.name}:{kind}" for obj, kind in records]
     ng[LIGHTS_SIGNATURE_KEY] = light_signature(records)
+    ng[LINKING_KEY] = {name: attr for name, (attr, _) in light_model.linking_attributes(records).items()}
+    light_model.sync_linking(scene.objects, records)
     return records
 
 
 def light_signature(records):
-    """What the RT Lit groups depend on in a light list: each light's name, kind and area shape."""
-    return [f"{obj.name}:{kind}:{_shape(obj) or ''}" for obj, kind in records]
+    """What the RT Lit groups and the lights' drivers depend on in a light list: each light's name, kind, area
+    shape and what its colour is the product of (``light_model.color_record``); then what the linked lights
+    exclude (``light_model.linking_record``)."""
+    return ([f"{obj.name}:{kind}:{light_model.shape(obj) or ''}:{light_model.color_record(obj.data)}"
+             for obj, kind in records] + light_model.linking_record(records))
 
 
 def lights_out_of_sync(scene):
@@ -211,6 +157,14 @@ def synced_light_kinds():
     return [tuple(entry.rsplit(":", 1)) for entry in entries]
 
 
+def synced_linking():
+    """{light name: (attribute, inverted)} of the linked lights at the last sync (``light_model.linking_attributes``):
+    what the RT Lit trees read for their "Excluded" inputs."""
+    ng = bpy.data.node_groups.get(SCENE_LIGHTS_GROUP)
+    stored = ng.get(LINKING_KEY, {}) if ng is not None else {}
+    return {name: (str(attr), light_model.is_inverted(str(attr))) for name, attr in dict(stored).items()}
+
+
 class _TreeInputs:
     """Sockets inside an RT Lit tree for the material function's internal inputs: the Geometry node,
     the lights group and the world group, each added once."""
@@ -231,6 +185,28 @@ class _TreeInputs:
                 node.location = (-400.0, 300.0)
                 return node
             return self._node("geometry", nodes, new).outputs[output]
+        return make
+
+    def attribute(self, name, inverted, y):
+        """The Fac output of an Attribute node (Object type) reading ``name`` (an object's custom property, 0
+        where the object has none), or 1 - Fac when ``inverted``."""
+        def make(nodes, links):
+            def new(nodes):
+                node = nodes.new("ShaderNodeAttribute")
+                node.attribute_type = "OBJECT"
+                node.attribute_name = name
+                node.label = name
+                node.location = (-600.0, y)
+                if not inverted:
+                    return node
+                invert = nodes.new("ShaderNodeMath")
+                invert.operation = "SUBTRACT"
+                invert.inputs[0].default_value = 1.0
+                invert.location = (-400.0, y)
+                links.new(node.outputs["Fac"], invert.inputs[1])
+                return invert
+            node = self._node(("attribute", name), nodes, new)
+            return node.outputs["Fac" if not inverted else "Value"]
         return make
 
     def group(self, key, group_name, y, output):
@@ -278,6 +254,7 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
     if bpy.data.node_groups.get(SCENE_LIGHTS_GROUP) is None:
         sync_scene_lights(scene)
     records = synced_light_kinds()
+    linked = synced_linking()
     shaded = tuple(range(len(records))) if lights is None else tuple(lights)
     name = rt_lit_group_name(features) if lights is None else culled_group_name(features, shaded)
     world = world_sync.world_environment()
@@ -289,15 +266,19 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
             material = rt_lit.build_rt_lit(features, tuple(records[i][1] for i in shaded), env)
         inputs = _TreeInputs()
         internal = {n: inputs.geometry(_GEOMETRY_SOCKETS[n]) for n in GEOMETRY_INPUTS}
-        # the material function's light k is the scene's light shaded[k]: "Light k p" <- "Light shaded[k] p"
+        # the material function's light k is the scene's light shaded[k]: "Light k p" <- "Light shaded[k] p"; the
+        # linking option's "Excluded" is the object's attribute (light_model.excluded_attribute)
         for k, per_light in enumerate(material.light_inputs):
-            internal.update({n: inputs.group("lights", SCENE_LIGHTS_GROUP, -200.0, light_input(shaded[k], param))
+            internal.update({n: (inputs.attribute(*linked[records[shaded[k]][0]], -900.0 - 120.0 * k)
+                                 if param == "Excluded" else
+                                 inputs.group("lights", SCENE_LIGHTS_GROUP, -200.0, light_input(shaded[k], param)))
                              for param, n in per_light.items()})
         internal.update({n: inputs.group("world", WORLD_GROUP, -600.0, n) for n in material.world_inputs.values()})
         trees[engine], _ = node_emit.ensure_tree(f"{name} [{engine}]", material.function,
                                                  material.material_inputs, sockets=(RT_LIT_INPUTS, RT_LIT_OUTPUTS),
                                                  internal_inputs=internal,
-                                                 stamp_extra=repr((records, shaded, world_record and world_record["table"])),
+                                                 stamp_extra=repr((records, shaded, world_record and world_record["table"],
+                                                                   sorted(linked.items()))),
                                                  tables=tables, shader_sums={"Shader": list(material.part_outputs)})
         material_inputs = material.material_inputs
     ng = _ensure_engine_group(name, trees, material_inputs)
@@ -594,11 +575,6 @@ def assign_rt_lit(material, features=None, scene=None, lut_dir=None):
     not_a_light(material)
     material[FEATURES_KEY] = (features or Features()).as_dict()
     return group
-
-
-def light_parameters(obj, kind):
-    """The values the drivers of ``obj`` deliver (parameter name -> float), for numpy evaluation."""
-    return {p: float(_static_value(obj, src)) for p, src in core_lights.driver_sources(kind, _shape(obj)).items()}
 
 
 def material_parameters(material):

@@ -101,10 +101,13 @@ def _light_summary(records):
 IGNORED_LIGHTS_NAMED = 4
 
 
-def _ignored_settings(records, materials):
-    """"Key (radius 0.1 m), Sun (angle 5.0 deg)": the light settings RT Lit does not shade, a few lights."""
+def _ignored_settings(records):
+    """"Key (node tree (...)), Fill (glossy ray visibility off)": the light settings RT Lit does not shade, a few
+    lights (``light_model.unshaded_settings``)."""
+    from . import light_model
+
     parts = [f"{obj.name} ({', '.join(found)})" for obj, kind in records
-             if (found := materials.ignored_light_settings(obj, kind))]
+             if (found := light_model.unshaded_settings(obj, kind))]
     if len(parts) > IGNORED_LIGHTS_NAMED:
         parts = parts[:IGNORED_LIGHTS_NAMED] + [f"{len(parts) - IGNORED_LIGHTS_NAMED} more lights"]
     return ", ".join(parts)
@@ -159,7 +162,7 @@ class RTL_OT_sync_lights(bpy.types.Operator):
             self.report({'ERROR'}, str(ex))
             return {'CANCELLED'}
         message = f"RT Lit: {len(records)} lights [{_light_summary(records)}]; {len(groups)} RT Lit groups rebuilt"
-        ignored = _ignored_settings(records, materials)
+        ignored = _ignored_settings(records)
         if ignored:
             message += f"; not shaded: {ignored}"
         over = _over_capacity(groups, len(records), WORLD_GROUP in bpy.data.node_groups)

@@ -16,7 +16,7 @@ from ..core.export import scene as description
 from ..core.lut import catalog
 from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import RT_LIT_INPUTS, Features
-from . import materials
+from . import light_model, materials
 from . import world_sync
 from .common import FEATURES_KEY, RT_LIT_NODE_NAME
 
@@ -52,7 +52,7 @@ def _lights(scene):
     if synced != kinds:
         raise SceneExportError(f"the RT Lit groups were built for the lights {synced}, the scene has {kinds}: "
                                "run RT Lookdev > Sync Lights first")
-    return [description.SceneLight(obj.name, kind, materials.light_parameters(obj, kind)) for obj, kind in found]
+    return [description.SceneLight(obj.name, kind, light_model.light_parameters(obj, kind)) for obj, kind in found]
 
 
 def _material(mat):
@@ -123,7 +123,9 @@ def _objects(scene):
         mats.setdefault(mat.name, entry)
         key = str(len(objects))
         geometry[key] = _triangles(obj, depsgraph)
-        objects.append(description.SceneObject(obj.name, mat.name, key, len(geometry[key][0]) // 3))
+        excluded = [light.name for light, kind in materials.scene_lights(scene)
+                    if not light_model.receives(light, obj)]
+        objects.append(description.SceneObject(obj.name, mat.name, key, len(geometry[key][0]) // 3, excluded))
     if not objects:
         raise SceneExportError(f"scene {scene.name!r} has no mesh object with an RT Lit material to export")
     return mats, objects, geometry, skipped

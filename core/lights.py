@@ -12,9 +12,14 @@ Cycles 5.0 conventions (source: blender/blender ``intern/cycles``; measured with
 module in tests/blender/test_light_units.py; see docs/blender.md, "Cycles light units"):
 
 - Strength.  The Blender sync (``blender/light.cpp: sync_light``) sets the light's strength to
-  ``color * energy`` (energy = Power P in W for point, spot and area lights, Strength S in W/m^2
-  for the sun).  We assume ``exposure = 0``, ``normalize = True`` and ``use_temperature = False``
-  (otherwise a driver must deliver ``energy * 2**exposure`` and ``color * temperature_color``).
+  ``color * energy * 2^exposure`` (energy = Power P in W for point, spot and area lights, Strength S
+  in W/m^2 for the sun), times the blackbody colour of its temperature (RNA ``temperature_color``)
+  when ``use_temperature`` is on, and a light node tree multiplies it by its emission; with
+  ``normalize`` off the power is not divided by the light's area (``Light::area``).  Here "Color"
+  is the product of the colours (the colour, the temperature's, the node tree's constant emission
+  colour times its strength: addon/materials.py drives it so), "Exposure" and "Normalize" are
+  inputs of every light (``exposure_scale``, ``emitting_area``).  All measured against Cycles in
+  tests/blender/test_light_units.py.
 - Area light (``scene/light.cpp``: ``Light::area``, ``device_update_lights``;
   ``kernel/light/area.h``): a one-sided emitter, centred on the object origin, spanning
   ``size`` along the object's X column and ``size_y`` (SQUARE and DISK: ``size``) along its Y
@@ -46,8 +51,31 @@ module in tests/blender/test_light_units.py; see docs/blender.md, "Cycles light 
   light's -Z axis, i.e. the direction to the light is its +Z axis; location and scale do not
   matter.
 
-RT Lit treats point and spot lights as radius 0 (``shadow_soft_size = 0``) and the sun as angle 0:
-the functions below describe exactly those lights, and the validation renders set them so.
+- Sphere lights (``kernel/light/point.h``, ``spot.h``; ``scene/light.cpp``): a point or spot light of
+  radius r > 0 emits the radiance L = P color / (pi 4 pi r^2) (normalize on; ``Light::area`` = 4 pi
+  r^2).  With Soft Falloff on (Blender's default; ``is_sphere`` off in Cycles) it is a disk of
+  radius r at the light's location that always faces the shading point; with it off, a sphere of
+  radius r, whose visible cap subtends the cone of half-angle asin(r/d).  Both are a uniform disk
+  facing the point (``facing_disk``): tan(half-angle) = r/d, resp. r / sqrt(d^2 - r^2), so every
+  lobe's disk form shades them.  A spot light's cone attenuation multiplies the radiance of each
+  direction (Cycles); here it is taken at the direction of the light's centre (and not applied
+  inside the sphere, as Cycles does not).
+- A sun of angle a > 0 (``kernel/light/distant.h``; ``Light::area`` = pi sin^2(a/2)): a uniform cone
+  of half-angle a/2 about its direction, radiance S color / (pi sin^2(a/2)) (normalize on): a disk
+  at unit distance facing the point, radius tan(a/2).
+- Area-light spread (``kernel/light/area.h``: ``area_light_spread_attenuation``,
+  ``area_light_spread_clamp_light``): core/light_spread.py.
+
+Mirrors.  For a world matrix M with a negative determinant (a negative scale, Ctrl+M, a mirrored
+parent) the TRANSFORMS drivers deliver the rotation of -M (a proper rotation) and the columns'
+lengths as the scale (measured with bpy 5.2: a light scaled (-1, 1, 1) reads scale (1, 1, 1) and a
+quaternion of -M), so rotation x scale is -M: the handedness is lost.  Every light whose orientation
+matters therefore takes the determinant of its world matrix as the input "Determinant" (a driver
+on ``matrix_world``'s nine entries), and its frame is sign(det) x rotation x scale (``light_frame``).
+Cycles emits area, spot and sun light along minus M's third column whatever its handedness
+(measured: a light mirrored in X or Y still lights the same side, one mirrored in Z the other):
+directions here are that column (``light_axis``), and an area light's corners are ordered so that
+they wind about it (``_area_axes``), so mirrored lights shade as Cycles'.
 
 Area-light geometry follows the repository's LTC convention (core/ltc/polygon.py,
 docs/conventions.md): quad corners p0..p3 are ordered so that (p1 - p0) x (p3 - p0) points
@@ -62,10 +90,10 @@ import math
 import numpy as np
 
 from . import shading_ops as op
-from . import falloff
+from . import falloff, light_spread
 from .falloff import MIN_DISTANCE
 from .ir.functions import NodeFunction
-from .ir.interface import Socket, scalar, vector
+from .ir.interface import Socket, factor, scalar, vector
 
 #: Smallest world-space area light area (m^2) that emits; smaller areas (0 size or 0 scale) give
 #: radiance 0, so P / (pi A) can neither divide by zero nor overflow float32.
@@ -91,69 +119,124 @@ def quat_rotate(w, x, y, z, vec):
     return op.scale(t, w) + op.cross(u, t) + vec
 
 
-def light_frame(location, w, x, y, z, scale_x, scale_y, scale_z):
+def sign_of(value):
+    """-1 where ``value`` < 0, else +1."""
+    return op.select(op.less(value, 0.0), -1.0, 1.0)
+
+
+def light_axis(w, x, y, z, scale_z, determinant=1.0):
+    """The unit direction of the light object's local +Z axis in world space (its world matrix's third
+    column, normalised): the rotation's Z axis times the signs of the Z scale and of the determinant
+    (module docstring, "Mirrors").  Area, spot and sun lights emit along minus this axis (Cycles)."""
+    return op.scale(quat_rotate(w, x, y, z, _EZ), sign_of(scale_z * determinant))
+
+
+def light_frame(location, w, x, y, z, scale_x, scale_y, scale_z, determinant=1.0):
     """World-space origin and axes of a light object: (origin, X, Y, Z), the columns of its world
-    matrix (rotation times scale); Z is the local +Z axis (area, spot and sun lights emit along -Z)."""
+    matrix, sign(det) x rotation x scale (module docstring, "Mirrors"); Z is the local +Z axis (area,
+    spot and sun lights emit along -Z)."""
+    h = sign_of(determinant)
     return (location,
-            op.scale(quat_rotate(w, x, y, z, _EX), scale_x),
-            op.scale(quat_rotate(w, x, y, z, _EY), scale_y),
-            op.scale(quat_rotate(w, x, y, z, _EZ), scale_z))
+            op.scale(quat_rotate(w, x, y, z, _EX), scale_x * h),
+            op.scale(quat_rotate(w, x, y, z, _EY), scale_y * h),
+            op.scale(quat_rotate(w, x, y, z, _EZ), scale_z * h))
+
+
+# --- Blender's light units --------------------------------------------------------------------------
+# Cycles (blender/light.cpp ``sync_light``; scene/light.cpp ``Light::area``, ``device_update_lights``) scales a
+# light's strength by 2^exposure and, with Normalize on, divides it by the light's area: the quad or ellipse
+# (world-space), 4 pi r^2 for a sphere light, 4 for a radius-0 point or spot light (so that I = P / (4 pi)),
+# pi sin^2(a/2) for a sun of angle a and 1 for an angle-0 sun.  With Normalize off it divides by 1.
+
+#: Blender's range of a light's Exposure (RNA hard limits), applied here too so 2^exposure stays finite.
+EXPOSURE_RANGE = (-32.0, 32.0)
+
+
+def exposure_scale(exposure):
+    """2^exposure: Blender's light Exposure (stops, clamped to its range) as a factor of its power."""
+    return op.exp2(op.clamp(exposure, *EXPOSURE_RANGE))
+
+
+def emitting_area(area, normalize):
+    """The area Cycles divides a light's power by: ``area`` with Normalize on (``normalize`` 1), 1 with it
+    off (0)."""
+    return op.select(op.greater(normalize, 0.5), area, 1.0)
+
+
+def emitted_radiance(power, color, area, exposure, normalize, factor=_INV_PI):
+    """L = P 2^exposure color factor / A for an emitter of area A (``emitting_area``), factor 1/pi for a
+    Lambertian one; 0 for A <= AREA_MIN (Cycles: no contribution; and P / A can neither divide by zero nor
+    overflow float32)."""
+    lum = op.safe_div(power * exposure_scale(exposure) * factor, emitting_area(area, normalize))
+    return op.scale(color, op.select(op.greater(area, AREA_MIN), lum, 0.0))
 
 
 # --- area lights --------------------------------------------------------------------------------
 
-def area_light_radiance(power, color, area):
-    """Emitted radiance L = P color / (pi A) of a Blender area light of world-space area A (m^2);
-    0 for A <= AREA_MIN."""
-    lum = op.select(op.greater(area, AREA_MIN), op.safe_div(power * _INV_PI, area), 0.0)
-    return op.scale(color, lum)
+def area_light_radiance(power, color, area, exposure=0.0, normalize=1.0):
+    """Emitted radiance L = P 2^exposure color / (pi A) of a Blender area light of world-space area A (m^2;
+    A = 1 with Normalize off); 0 for A <= AREA_MIN (Cycles: no contribution)."""
+    return emitted_radiance(power, color, area, exposure, normalize)
 
 
-def area_light_quad(location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y):
+def _area_axes(w, x, y, z, scale_x, scale_y, scale_z, size, size_y, determinant=1.0):
+    """Half-extent vectors (eu, ev) of an area light and its area A: the world matrix's X and Y columns times
+    the half sizes, Y flipped where the matrix mirrors, so that eu x ev points along its Z column (away from
+    the lit side) as Cycles emits (``light_axis``).  With h = sign(det): eu = h R X half_u and ev = h R Y half_v
+    sign(h sx sy sz) = R Y half_v sign(sx sy sz)."""
+    half_u = scale_x * size * 0.5
+    half_v = scale_y * size_y * 0.5
+    eu = op.scale(quat_rotate(w, x, y, z, _EX), half_u * sign_of(determinant))
+    ev = op.scale(quat_rotate(w, x, y, z, _EY), half_v * sign_of(scale_x * scale_y * scale_z))
+    return eu, ev, op.absolute(half_u * half_v) * 4.0
+
+
+def area_light_quad(location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y, exposure=0.0,
+                    normalize=1.0, determinant=1.0):
     """World corners (p0, p1, p2, p3) and radiance of a SQUARE / RECTANGLE area light.
 
     ``size_y`` is the light's Y extent: pass ``size`` for SQUARE.  The corners are
-    (-u, -v), (+u, -v), (+u, +v), (-u, +v) in the light's local XY plane (u = size/2, v = size_y/2),
-    so (p1 - p0) x (p3 - p0) points along local +Z, away from the lit side.  ``scale_z`` does not
-    matter (it is taken for a signature common to all lights' transforms)."""
-    half_u = scale_x * size * 0.5
-    half_v = scale_y * size_y * 0.5
-    eu = op.scale(quat_rotate(w, x, y, z, _EX), half_u)
-    ev = op.scale(quat_rotate(w, x, y, z, _EY), half_v)
+    (-u, -v), (+u, -v), (+u, +v), (-u, +v) in the light's local XY plane (u = size/2, v = size_y/2;
+    v mirrored with the matrix), so (p1 - p0) x (p3 - p0) points along the light's +Z axis, away from
+    the lit side."""
+    eu, ev, area = _area_axes(w, x, y, z, scale_x, scale_y, scale_z, size, size_y, determinant)
     low, high = location - eu, location + eu
     corners = (low - ev, high - ev, high + ev, low + ev)
-    area = op.absolute(half_u * half_v) * 4.0
-    return corners + (area_light_radiance(power, color, area),)
+    return corners + (area_light_radiance(power, color, area, exposure, normalize),)
 
 
-def area_light_disk(location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y):
+def area_light_disk(location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y, exposure=0.0,
+                    normalize=1.0, determinant=1.0):
     """Centre, semi-axis vectors (axis_u, axis_v) and radiance of a DISK / ELLIPSE area light.
 
-    ``size_y`` is the light's Y diameter: pass ``size`` for DISK.  axis_u x axis_v points along
-    local +Z, away from the lit side."""
-    half_u = scale_x * size * 0.5
-    half_v = scale_y * size_y * 0.5
-    axis_u = op.scale(quat_rotate(w, x, y, z, _EX), half_u)
-    axis_v = op.scale(quat_rotate(w, x, y, z, _EY), half_v)
-    area = op.absolute(half_u * half_v) * np.pi
-    return location, axis_u, axis_v, area_light_radiance(power, color, area)
+    ``size_y`` is the light's Y diameter: pass ``size`` for DISK.  axis_u x axis_v points along the
+    light's +Z axis, away from the lit side."""
+    axis_u, axis_v, quad_area = _area_axes(w, x, y, z, scale_x, scale_y, scale_z, size, size_y, determinant)
+    area = quad_area * (np.pi / 4.0)
+    return location, axis_u, axis_v, area_light_radiance(power, color, area, exposure, normalize)
 
 
-def area_light(shape, location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y):
+def area_light(shape, location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y, exposure=0.0,
+               normalize=1.0):
     """``area_light_quad`` or ``area_light_disk`` by Blender's ``shape`` (a build-time string):
     SQUARE and DISK use ``size`` for both extents, as Cycles does."""
     if shape not in ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE"):
         raise ValueError(f"unknown area light shape {shape!r}")
     fn = area_light_quad if shape in ("SQUARE", "RECTANGLE") else area_light_disk
     return fn(location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size,
-              size if shape in ("SQUARE", "DISK") else size_y)
+              size if shape in ("SQUARE", "DISK") else size_y, exposure, normalize)
 
 
 # --- point, spot and sun ------------------------------------------------------------------------
 
-def point_light_intensity(power, color):
-    """Radiant intensity I = P color / (4 pi) (W/sr) of a radius-0 point or spot light."""
-    return op.scale(color, power * _INV_4PI)
+#: Cycles' area of a radius-0 point or spot light (``Light::area``): the power is divided by pi x 4.
+POINT_AREA = 4.0
+
+
+def point_light_intensity(power, color, exposure=0.0, normalize=1.0):
+    """Radiant intensity I = P 2^exposure color / (4 pi) (W/sr) of a radius-0 point or spot light; P color / pi
+    with Normalize off."""
+    return emitted_radiance(power, color, POINT_AREA, exposure, normalize)
 
 
 def _towards(position, location):
@@ -163,12 +246,12 @@ def _towards(position, location):
     return op.normalize(d), 1.0 / dist2
 
 
-def point_light_incidence(position, location, power, color):
+def point_light_incidence(position, location, power, color, exposure=0.0, normalize=1.0):
     """(l, E): unit direction to a radius-0 point light and the irradiance at normal incidence
     E = I / max(d^2, MIN_DISTANCE^2) (W/m^2, colour; the cosine is not included).  At the light
     itself l = 0 and E is finite."""
     l, inv_d2 = _towards(position, location)
-    return l, op.scale(point_light_intensity(power, color), inv_d2)
+    return l, op.scale(point_light_intensity(power, color, exposure, normalize), inv_d2)
 
 
 def smoothstep(t):
@@ -186,26 +269,134 @@ def spot_attenuation(cos_axis, spot_size, spot_blend):
     return smoothstep((cos_axis - cos_half) / width)
 
 
-def spot_cosine(position, location, w, x, y, z, scale_x, scale_y, scale_z):
-    """Cosine between the spot axis (local -Z) and the direction from the light to ``position``,
-    measured in the light's local frame (inverse rotation, then inverse scale), as Cycles does."""
+def to_local(vec, w, x, y, z, scale_x, scale_y, scale_z, determinant=1.0):
+    """A world-space vector in the light's local frame: the inverse of sign(det) x rotation x scale applied."""
     # (-w, x, y, z) = -conjugate(q): the inverse rotation, with one negation instead of three
-    local = quat_rotate(-w, x, y, z, position - location)
-    inv_scale = op.vec3(op.safe_div(1.0, scale_x), op.safe_div(1.0, scale_y), op.safe_div(1.0, scale_z))
-    return -op.component(op.normalize(op.vmul(local, inv_scale)), 2)
+    local = quat_rotate(-w, x, y, z, vec)
+    h = sign_of(determinant)
+    return op.vmul(local, op.vec3(op.safe_div(h, scale_x), op.safe_div(h, scale_y), op.safe_div(h, scale_z)))
+
+
+def spot_cosine(position, location, w, x, y, z, scale_x, scale_y, scale_z, determinant=1.0):
+    """Cosine between the spot axis (local -Z) and the direction from the light to ``position``,
+    measured in the light's local frame (the inverse of sign(det) x rotation x scale), as Cycles does."""
+    return local_cosine(to_local(position - location, w, x, y, z, scale_x, scale_y, scale_z, determinant))
+
+
+def local_cosine(local):
+    """The cosine between a local-frame direction and the light's -Z axis."""
+    return -op.component(op.normalize(local), 2)
 
 
 def spot_light_incidence(position, location, w, x, y, z, scale_x, scale_y, scale_z, power, color,
-                         spot_size, spot_blend):
+                         spot_size, spot_blend, exposure=0.0, normalize=1.0, determinant=1.0):
     """(l, E) of a radius-0 spot light: the point light's incidence times the cone attenuation."""
-    l, e = point_light_incidence(position, location, power, color)
-    c = spot_cosine(position, location, w, x, y, z, scale_x, scale_y, scale_z)
+    l, e = point_light_incidence(position, location, power, color, exposure, normalize)
+    c = spot_cosine(position, location, w, x, y, z, scale_x, scale_y, scale_z, determinant)
     return l, op.scale(e, spot_attenuation(c, spot_size, spot_blend))
 
 
-def sun_light_incidence(w, x, y, z, strength, color):
-    """(l, E) of an angle-0 sun: l is the light's local +Z axis (it shines along -Z), E = S color."""
-    return quat_rotate(w, x, y, z, _EZ), op.scale(color, strength)
+def sun_light_incidence(w, x, y, z, scale_z, strength, color, exposure=0.0, determinant=1.0):
+    """(l, E) of an angle-0 sun: l is the light's local +Z axis (it shines along -Z; ``light_axis``),
+    E = S 2^exposure color (Normalize divides by an area of 1)."""
+    return light_axis(w, x, y, z, scale_z, determinant), op.scale(color, strength * exposure_scale(exposure))
+
+
+# --- sphere lights and suns with an angle: a uniform disk facing the shading point -------------------
+
+#: Largest tangent of the half-angle of a facing disk (89.4 deg): a point inside a sphere light (or at the centre of
+#: a soft-falloff disk) sees the disk towards the light's centre, not Cycles' whole sphere of directions; the bound
+#: keeps the disk integrals finite in float32.
+FACING_DISK_TAN_MAX = 100.0
+FACING_DISK_COS_MIN = 1.0 / math.sqrt(1.0 + FACING_DISK_TAN_MAX * FACING_DISK_TAN_MAX)
+
+
+def tangent_basis(n):
+    """(t1, t2): unit tangents of the unit vector n with t1 x t2 = n: t1 = normalize(helper x n) with the helper
+    axis +Z, or +X where n is within 25 deg of +-Z (so the cross product never degenerates), t2 = n x t1."""
+    helper = op.vselect(op.less(op.absolute(op.component(n, 2)), 0.9), _EZ, _EX)
+    t1 = op.normalize(op.cross(helper, n))
+    return t1, op.cross(n, t1)
+
+
+def facing_disk(position, direction, distance, tan_half_angle):
+    """(centre, axis_u, axis_v) of the disk that subtends the cone of half-angle a about the unit ``direction``
+    from ``position``: at ``distance`` along it, radius distance tan(a) (tan(a) at most FACING_DISK_TAN_MAX),
+    axis_u x axis_v = direction (pointing away from the lit side: the LTC convention)."""
+    t1, t2 = tangent_basis(direction)
+    radius = distance * op.minimum(tan_half_angle, FACING_DISK_TAN_MAX)
+    return position + op.scale(direction, distance), op.scale(t1, radius), op.scale(t2, radius)
+
+
+def sphere_tan_half_angle(distance, radius, soft_falloff):
+    """tan of the half-angle a sphere light of ``radius`` subtends at ``distance``: r/d with Soft Falloff (Cycles'
+    disk of radius r facing the point), r / sqrt(d^2 - r^2) without (the visible cap of the sphere, sin a = r/d);
+    FACING_DISK_TAN_MAX at and inside the sphere."""
+    soft = op.safe_div(radius, distance)
+    gap = distance * distance - radius * radius
+    sphere = op.select(op.greater(gap, 0.0), op.safe_div(radius, op.sqrt(gap)), FACING_DISK_TAN_MAX)
+    return op.select(op.greater(soft_falloff, 0.5), soft, sphere)
+
+
+def sphere_light_area(radius):
+    """Cycles' area of a point or spot light of radius r > 0: the sphere's, 4 pi r^2."""
+    return (4.0 * np.pi) * radius * radius
+
+
+def sphere_light(position, location, power, color, radius, soft_falloff, exposure=0.0, normalize=1.0):
+    """(centre, axis_u, axis_v, radiance) of a point light of radius r > 0 seen from ``position``: the disk facing
+    the point that subtends what the light does (``sphere_tan_half_angle``), at the light's location, with the
+    sphere's radiance P 2^exposure color / (pi 4 pi r^2)."""
+    d = location - position
+    distance = op.maximum(op.length(d), MIN_DISTANCE)
+    direction = op.normalize(d)
+    centre, axis_u, axis_v = facing_disk(position, direction, distance,
+                                         sphere_tan_half_angle(distance, radius, soft_falloff))
+    return centre, axis_u, axis_v, emitted_radiance(power, color, sphere_light_area(radius), exposure, normalize)
+
+
+#: Chebyshev-Gauss rule of the second kind on [-1, 1] with three points (weight sqrt(1 - x^2): a uniform disk's
+#: density along a diameter): the points across the spot sphere's disk at which its cone attenuation is averaged.
+DISK_DIAMETER_RULE = ((-math.sqrt(0.5), 0.25), (0.0, 0.5), (math.sqrt(0.5), 0.25))
+
+
+def spot_sphere_light(position, location, w, x, y, z, scale_x, scale_y, scale_z, power, color, radius,
+                      soft_falloff, spot_size, spot_blend, exposure=0.0, normalize=1.0, determinant=1.0):
+    """``sphere_light`` times the spot's cone attenuation towards ``position`` (outside the sphere only, as Cycles).
+    Cycles attenuates each direction to the light by the cone at the point it comes from; here the attenuation is
+    averaged over three points of the facing disk on the diameter along which the cone's axis tilts
+    (``DISK_DIAMETER_RULE``: the disk's density along it), which keeps the penumbra a sphere light casts at the
+    cone's edge."""
+    centre, axis_u, axis_v, radiance = sphere_light(position, location, power, color, radius, soft_falloff,
+                                                    exposure, normalize)
+    towards = op.normalize(location - position)
+    emits = op.scale(light_axis(w, x, y, z, scale_z, determinant), -1.0)
+    tilt = op.normalize(emits - op.scale(towards, op.dot(emits, towards)))
+    frame = (w, x, y, z, scale_x, scale_y, scale_z, determinant)
+    # the direction from a point of the disk to the shading point, in the local frame: one transform of each part
+    to_point = to_local(position - location, *frame)
+    across = to_local(op.scale(tilt, op.length(axis_u)), *frame)
+    cone = 0.0
+    for offset, weight in DISK_DIAMETER_RULE:
+        c = local_cosine(to_point - op.scale(across, offset))
+        cone = spot_attenuation(c, spot_size, spot_blend) * weight + cone
+    d = location - position
+    outside = op.greater(op.dot(d, d), radius * radius)
+    return centre, axis_u, axis_v, op.scale(radiance, op.select(outside, cone, 1.0))
+
+
+def sun_disk_light(position, w, x, y, z, scale_z, strength, color, angle, exposure=0.0, normalize=1.0,
+                   determinant=1.0):
+    """(centre, axis_u, axis_v, radiance) of a sun of angle a > 0: the disk at unit distance towards the sun
+    subtending a/2, radiance S 2^exposure color / (pi sin^2(a/2)) (Normalize on; Cycles ``Light::area``)."""
+    half = op.clamp(angle * 0.5, 0.0, 0.5 * np.pi)
+    sin_half = op.sin(half)
+    # tan(a/2) as sin / cos, the cosine bounded (not the angle: near pi/2 the tangent would amplify the bound's
+    # float32 rounding a hundredfold)
+    tan_half = op.safe_div(sin_half, op.maximum(op.cos(half), FACING_DISK_COS_MIN))
+    centre, axis_u, axis_v = facing_disk(position, light_axis(w, x, y, z, scale_z, determinant), 1.0, tan_half)
+    area = np.pi * sin_half * sin_half
+    return centre, axis_u, axis_v, emitted_radiance(strength, color, area, exposure, normalize, factor=1.0)
 
 
 # --- node functions -----------------------------------------------------------------------------
@@ -228,14 +419,18 @@ def _rotation_sockets():
 
 
 def _scale_sockets():
-    return {f"Scale {a}": scalar(1.0, f"World-space scale {a} of the light object (driver: Transform "
-                                      f"Channel SCALE_{a}, world space)", panel=_TRANSFORM_PANEL)
-            for a in "XYZ"}
+    out = {f"Scale {a}": scalar(1.0, f"World-space scale {a} of the light object (driver: Transform "
+                                     f"Channel SCALE_{a}, world space)", panel=_TRANSFORM_PANEL)
+           for a in "XYZ"}
+    out["Determinant"] = scalar(1.0, "Determinant of the light object's world matrix: negative for a mirrored "
+                                     "light (driver: the 3 x 3 determinant of matrix_world)", panel=_TRANSFORM_PANEL)
+    return out
 
 
 def _color_sockets():
-    return {f"Color {c}": scalar(1.0, f"Light colour, {name} channel (light data color[{i}])", 0.0, None,
-                                 panel=_DATA_PANEL)
+    return {f"Color {c}": scalar(1.0, f"Light colour, {name} channel: light data color[{i}] times the blackbody "
+                                      f"colour of its temperature (when used) and its node tree's constant emission "
+                                      f"colour and strength", 0.0, None, panel=_DATA_PANEL)
             for i, (c, name) in enumerate((("R", "red"), ("G", "green"), ("B", "blue")))}
 
 
@@ -244,12 +439,34 @@ def _power_socket(what):
                             panel=_DATA_PANEL)}
 
 
+def _units_sockets():
+    return {"Exposure": scalar(0.0, "Exposure in stops: the power times 2^exposure (light data exposure)",
+                               *EXPOSURE_RANGE, panel=_DATA_PANEL),
+            "Normalize": factor(1.0, "1: the power is divided by the light's area (light data normalize); 0: by 1",
+                                panel=_DATA_PANEL)}
+
+
 def _size_sockets(shape):
     return {"Size": scalar(1.0, f"{shape} size along the light's X axis in m (light data size)", 0.0, None,
                            subtype="DISTANCE", panel=_DATA_PANEL),
             "Size Y": scalar(1.0, f"{shape} size along the light's Y axis in m (light data size_y; "
                                   f"drive it from size for a {'SQUARE' if shape == 'Quad' else 'DISK'} light)",
                              0.0, None, subtype="DISTANCE", panel=_DATA_PANEL)}
+
+
+def _spot_sockets():
+    return {"Spot Size": scalar(np.pi / 4, "Full cone angle (light data spot_size)", 0.0, np.pi, subtype="ANGLE",
+                                panel=_DATA_PANEL),
+            "Spot Blend": scalar(0.15, "Softness of the cone edge (light data spot_blend)", 0.0, 1.0,
+                                 subtype="FACTOR", panel=_DATA_PANEL)}
+
+
+def _sphere_sockets():
+    return {"Radius": scalar(0.1, "Radius r of the light in m (light data shadow_soft_size)", 0.0, None,
+                             subtype="DISTANCE", panel=_DATA_PANEL),
+            "Soft Falloff": factor(1.0, "1: a disk of radius r facing the shading point (Cycles' Soft Falloff, "
+                                        "Blender's default); 0: a sphere (light data use_soft_falloff)",
+                                   panel=_DATA_PANEL)}
 
 
 _POSITION = {"Position": vector("Shading point (world space)", "NONE", hide_value=True)}
@@ -277,32 +494,62 @@ def _col(kw):
     return op.vec3(kw["Color R"], kw["Color G"], kw["Color B"])
 
 
+def _units(kw):
+    return kw["Exposure"], kw["Normalize"]
+
+
+def _oriented_units(kw):
+    """Exposure, Normalize and Determinant: the trailing arguments of the oriented lights' functions."""
+    return kw["Exposure"], kw["Normalize"], kw["Determinant"]
+
+
 def _quad_node(**kw):
     p0, p1, p2, p3, radiance = area_light_quad(_loc(kw), *_rot(kw), *_scl(kw), kw["Power"], _col(kw),
-                                               kw["Size"], kw["Size Y"])
+                                               kw["Size"], kw["Size Y"], *_oriented_units(kw))
     return {"p0": p0, "p1": p1, "p2": p2, "p3": p3, "Center": _loc(kw), "Radiance": radiance}
 
 
 def _disk_node(**kw):
     center, axis_u, axis_v, radiance = area_light_disk(_loc(kw), *_rot(kw), *_scl(kw), kw["Power"], _col(kw),
-                                                       kw["Size"], kw["Size Y"])
+                                                       kw["Size"], kw["Size Y"], *_oriented_units(kw))
     return {"Center": center, "Axis U": axis_u, "Axis V": axis_v, "Radiance": radiance}
 
 
 def _point_node(**kw):
-    l, e = point_light_incidence(kw["Position"], _loc(kw), kw["Power"], _col(kw))
+    l, e = point_light_incidence(kw["Position"], _loc(kw), kw["Power"], _col(kw), *_units(kw))
     return {"L": l, "Irradiance": e}
 
 
 def _spot_node(**kw):
     l, e = spot_light_incidence(kw["Position"], _loc(kw), *_rot(kw), *_scl(kw), kw["Power"], _col(kw),
-                                kw["Spot Size"], kw["Spot Blend"])
+                                kw["Spot Size"], kw["Spot Blend"], *_oriented_units(kw))
     return {"L": l, "Irradiance": e}
 
 
 def _sun_node(**kw):
-    l, e = sun_light_incidence(*_rot(kw), kw["Strength"], _col(kw))
+    l, e = sun_light_incidence(*_rot(kw), kw["Scale Z"], kw["Strength"], _col(kw), kw["Exposure"],
+                               kw["Determinant"])
     return {"L": l, "Irradiance": e}
+
+
+def _disk_outputs(center, axis_u, axis_v, radiance):
+    return {"Center": center, "Axis U": axis_u, "Axis V": axis_v, "Radiance": radiance}
+
+
+def _sphere_node(**kw):
+    return _disk_outputs(*sphere_light(kw["Position"], _loc(kw), kw["Power"], _col(kw), kw["Radius"],
+                                       kw["Soft Falloff"], *_units(kw)))
+
+
+def _spot_sphere_node(**kw):
+    return _disk_outputs(*spot_sphere_light(kw["Position"], _loc(kw), *_rot(kw), *_scl(kw), kw["Power"], _col(kw),
+                                            kw["Radius"], kw["Soft Falloff"], kw["Spot Size"], kw["Spot Blend"],
+                                            *_oriented_units(kw)))
+
+
+def _sun_disk_node(**kw):
+    return _disk_outputs(*sun_disk_light(kw["Position"], *_rot(kw), kw["Scale Z"], kw["Strength"], _col(kw),
+                                         kw["Angle"], *_oriented_units(kw)))
 
 
 def _corner(i):
@@ -310,10 +557,25 @@ def _corner(i):
                   "XYZ", hide_value=True)
 
 
+_DISK_OUTPUTS = {
+    "Center": vector("World-space centre of the disk or ellipse", "XYZ", hide_value=True),
+    "Axis U": vector("Semi-axis along the light's X axis; Axis U x Axis V points away from the lit side",
+                     "XYZ", hide_value=True),
+    "Axis V": vector("Semi-axis along the light's Y axis", "XYZ", hide_value=True),
+    "Radiance": _RADIANCE}
+_FACING_DISK_OUTPUTS = {
+    "Center": vector("World-space centre of the disk facing the shading point", "XYZ", hide_value=True),
+    "Axis U": vector("Semi-axis of the disk; Axis U x Axis V points from the shading point to the light", "XYZ",
+                     hide_value=True),
+    "Axis V": vector("Second semi-axis of the disk", "XYZ", hide_value=True),
+    "Radiance": _RADIANCE}
+_STRENGTH = {"Strength": scalar(1.0, "Sun strength S: irradiance in W/m^2 (light data energy)", 0.0, None,
+                                panel=_DATA_PANEL)}
+
 AREA_LIGHT_QUAD = NodeFunction(
     "RTL Area Light Quad", _quad_node,
     {**_location_sockets(), **_rotation_sockets(), **_scale_sockets(), **_power_socket("Area light"),
-     **_color_sockets(), **_size_sockets("Quad")},
+     **_color_sockets(), **_size_sockets("Quad"), **_units_sockets()},
     {**{f"p{i}": _corner(i) for i in range(4)},
      "Center": vector("World-space centre (the light's location): the side the shading point is on is taken from "
                       "it, which the corners of a light much larger than its distance round away", "XYZ",
@@ -324,39 +586,55 @@ AREA_LIGHT_QUAD = NodeFunction(
 AREA_LIGHT_DISK = NodeFunction(
     "RTL Area Light Disk", _disk_node,
     {**_location_sockets(), **_rotation_sockets(), **_scale_sockets(), **_power_socket("Area light"),
-     **_color_sockets(), **_size_sockets("Disk")},
-    {"Center": vector("World-space centre of the disk or ellipse", "XYZ", hide_value=True),
-     "Axis U": vector("Semi-axis along the light's X axis; Axis U x Axis V points away from the lit side",
-                      "XYZ", hide_value=True),
-     "Axis V": vector("Semi-axis along the light's Y axis", "XYZ", hide_value=True),
-     "Radiance": _RADIANCE},
+     **_color_sockets(), **_size_sockets("Disk"), **_units_sockets()},
+    _DISK_OUTPUTS,
     "A DISK or ELLIPSE Blender area light: centre, semi-axes and emitted radiance (Cycles units)")
 
 POINT_LIGHT = NodeFunction(
     "RTL Point Light", _point_node,
-    {**_location_sockets(), **_power_socket("Point light"), **_color_sockets(), **_POSITION},
+    {**_location_sockets(), **_power_socket("Point light"), **_color_sockets(), **_units_sockets(), **_POSITION},
     {"L": _L, "Irradiance": _IRRADIANCE},
     "A radius-0 Blender point light: I = P color / (4 pi), irradiance I / d^2 (d >= 1 cm)")
 
 SPOT_LIGHT = NodeFunction(
     "RTL Spot Light", _spot_node,
     {**_location_sockets(), **_rotation_sockets(), **_scale_sockets(), **_power_socket("Spot light"),
-     **_color_sockets(),
-     "Spot Size": scalar(np.pi / 4, "Full cone angle (light data spot_size)", 0.0, np.pi, subtype="ANGLE",
-                         panel=_DATA_PANEL),
-     "Spot Blend": scalar(0.15, "Softness of the cone edge (light data spot_blend)", 0.0, 1.0,
-                          subtype="FACTOR", panel=_DATA_PANEL),
-     **_POSITION},
+     **_color_sockets(), **_spot_sockets(), **_units_sockets(), **_POSITION},
     {"L": _L, "Irradiance": _IRRADIANCE},
     "A radius-0 Blender spot light: the point light's intensity times Cycles' cone attenuation")
 
 SUN_LIGHT = NodeFunction(
     "RTL Sun Light", _sun_node,
-    {**_rotation_sockets(), **{"Strength": scalar(1.0, "Sun strength S: irradiance in W/m^2 (light data "
-                                                       "energy)", 0.0, None, panel=_DATA_PANEL)},
-     **_color_sockets()},
+    {**_rotation_sockets(), **_scale_sockets(), **_STRENGTH, **_color_sockets(), **_units_sockets()},
     {"L": _L, "Irradiance": _IRRADIANCE},
     "An angle-0 Blender sun: direction to the sun (its +Z axis) and irradiance S color")
+
+SPHERE_LIGHT = NodeFunction(
+    "RTL Sphere Light", _sphere_node,
+    {**_location_sockets(), **_power_socket("Point light"), **_color_sockets(), **_sphere_sockets(),
+     **_units_sockets(), **_POSITION},
+    _FACING_DISK_OUTPUTS,
+    "A Blender point light of radius r > 0: the disk facing the shading point that it subtends (a disk of radius r "
+    "with Soft Falloff, the sphere's cap without), radiance P color / (4 pi^2 r^2)")
+
+SPOT_SPHERE_LIGHT = NodeFunction(
+    "RTL Spot Sphere Light", _spot_sphere_node,
+    {**_location_sockets(), **_rotation_sockets(), **_scale_sockets(), **_power_socket("Spot light"),
+     **_color_sockets(), **_sphere_sockets(), **_spot_sockets(), **_units_sockets(), **_POSITION},
+    _FACING_DISK_OUTPUTS,
+    "A Blender spot light of radius r > 0: the sphere light's facing disk times the cone attenuation towards the "
+    "shading point")
+
+SUN_DISK_LIGHT = NodeFunction(
+    "RTL Sun Disk Light", _sun_disk_node,
+    {**_rotation_sockets(), **_scale_sockets(), **_STRENGTH, **_color_sockets(),
+     "Angle": scalar(math.radians(0.526), "Angular diameter of the sun (light data angle)", 0.0, np.pi,
+                     subtype="ANGLE", panel=_DATA_PANEL),
+     **_units_sockets(), **_POSITION},
+    _FACING_DISK_OUTPUTS,
+    "A Blender sun of angle a > 0: the disk at unit distance subtending a/2 about its direction, radiance "
+    "S color / (pi sin^2(a/2))")
+
 
 # --- the talk's epilogue: light controls ---------------------------------------------------------------
 # "Control over performance: radius falloff, cone angle falloff; fall back to point lights: omni or spot light."
@@ -373,10 +651,12 @@ def area_light_diameter(scale_x, scale_y, size, size_y, shape):
     return op.maximum(dx, dy)
 
 
-def projector_apex(location, w, x, y, z, scale_x, scale_y, size, size_y, outer_angle, shape):
+def projector_apex(location, w, x, y, z, scale_x, scale_y, scale_z, size, size_y, outer_angle, shape,
+                   determinant=1.0):
     """(apex, emission axis): the talk's projector point behind an area light, p = (d/2)/tan(phi/2) behind its
-    centre (``falloff.projector_distance``), and the unit direction the light emits along (its local -Z)."""
-    axis = op.scale(quat_rotate(w, x, y, z, _EZ), -1.0)
+    centre (``falloff.projector_distance``), and the unit direction the light emits along (its local -Z axis,
+    mirrored or not: ``light_axis``)."""
+    axis = op.scale(light_axis(w, x, y, z, scale_z, determinant), -1.0)
     p = falloff.projector_distance(area_light_diameter(scale_x, scale_y, size, size_y, shape), outer_angle)
     return location - op.scale(axis, p), axis
 
@@ -393,9 +673,10 @@ def range_falloff(position, location, radius):
 
 
 def quad_spot_incidence(position, location, w, x, y, z, scale_x, scale_y, scale_z, power, color, size, size_y,
-                        inner_angle, outer_angle):
+                        inner_angle, outer_angle, exposure=0.0, normalize=1.0, determinant=1.0):
     """(l, E) of the quad-to-spot fallback: the quad's far field, a point at its centre of intensity
-    I(theta) = L A cos(theta) = P color cos(theta) / pi (a Lambertian emitter, theta from its axis), times the talk's
+    I(theta) = L A cos(theta) = P color cos(theta) / pi (a Lambertian emitter, theta from its axis; L A = P / pi
+    with Normalize on, P A / pi with it off, 0 for a light of no area), times the talk's
     cone falloff at the projector apex behind the quad; E = I / max(d^2, d_min^2), d from the centre.
 
     The talk's images show a spot at the apex, which emits the same intensity in every direction of its cone: it
@@ -403,16 +684,19 @@ def quad_spot_incidence(position, location, w, x, y, z, scale_x, scale_y, scale_
     with distance; a spot at the apex with the cosine converges as the apex offset over the distance (10% at one
     light size, 1% at ten); at the centre it is the quad's far field, 2.5% at two light diameters, 0.3% at six
     (docs/benchmarks/light_fallback.md)."""
-    apex, axis = projector_apex(location, w, x, y, z, scale_x, scale_y, size, size_y, outer_angle, "quad")
+    apex, axis = projector_apex(location, w, x, y, z, scale_x, scale_y, scale_z, size, size_y, outer_angle, "quad",
+                                determinant)
     l, inv_d2 = _towards(position, location)
     emission = op.maximum(-op.dot(l, axis), 0.0)
     cone = apex_cone_falloff(position, apex, axis, inner_angle, outer_angle)
-    return l, op.scale(color, power * _INV_PI * inv_d2 * emission * cone)
+    _, _, area = _area_axes(w, x, y, z, scale_x, scale_y, scale_z, size, size_y)
+    intensity = op.scale(area_light_radiance(power, color, area, exposure, normalize), area)
+    return l, op.scale(intensity, inv_d2 * emission * cone)
 
 
 def _quad_spot_node(**kw):
     l, e = quad_spot_incidence(kw["Position"], _loc(kw), *_rot(kw), *_scl(kw), kw["Power"], _col(kw), kw["Size"],
-                               kw["Size Y"], kw["Cone Inner"], kw["Cone Outer"])
+                               kw["Size Y"], kw["Cone Inner"], kw["Cone Outer"], *_oriented_units(kw))
     return {"L": l, "Irradiance": e}
 
 
@@ -427,22 +711,43 @@ def _cone_sockets():
 QUAD_SPOT_LIGHT = NodeFunction(
     "RTL Quad Spot Fallback Light", _quad_spot_node,
     {**_location_sockets(), **_rotation_sockets(), **_scale_sockets(), **_power_socket("Area light"),
-     **_color_sockets(), **_size_sockets("Quad"), **_cone_sockets(), **_POSITION},
+     **_color_sockets(), **_size_sockets("Quad"), **_cone_sockets(), **_units_sockets(), **_POSITION},
     {"L": _L, "Irradiance": _IRRADIANCE},
     "The talk's quad-to-spot fallback: the quad's far field, P color cos / pi from its centre, with the cone falloff "
     "at the projector apex")
 
-NODE_FUNCTIONS = (AREA_LIGHT_QUAD, AREA_LIGHT_DISK, POINT_LIGHT, SPOT_LIGHT, SUN_LIGHT, QUAD_SPOT_LIGHT)
+NODE_FUNCTIONS = (AREA_LIGHT_QUAD, AREA_LIGHT_DISK, POINT_LIGHT, SPOT_LIGHT, SUN_LIGHT, QUAD_SPOT_LIGHT,
+                  SPHERE_LIGHT, SPOT_SPHERE_LIGHT, SUN_DISK_LIGHT)
 
 #: RT Lit light kind -> the node function that turns driver values into light geometry.
 LIGHT_DATA = {"quad": AREA_LIGHT_QUAD, "disk": AREA_LIGHT_DISK, "point": POINT_LIGHT, "spot": SPOT_LIGHT,
-              "sun": SUN_LIGHT, "quad_spot": QUAD_SPOT_LIGHT}
+              "sun": SUN_LIGHT, "quad_spot": QUAD_SPOT_LIGHT, "sphere": SPHERE_LIGHT, "spot_sphere": SPOT_SPHERE_LIGHT,
+              "sun_disk": SUN_DISK_LIGHT}
+
+#: How the lobes shade each kind: over a polygon ("quad"), over an ellipse ("disk"; sphere lights and suns with an
+#: angle are the disk facing the point), or at one direction ("punctual").
+SHADING_FORMS = {"quad": "quad", "disk": "disk", "sphere": "disk", "spot_sphere": "disk", "sun_disk": "disk",
+                 "point": "punctual", "spot": "punctual", "sun": "punctual", "quad_spot": "punctual"}
+#: Inputs of a light's data function that the material feeds from the shading point, not from the light.
+SHADING_POINT_INPUTS = ("Position", "Normal")
+
+
+def shading_form(kind):
+    """"quad", "disk" or "punctual": how the lobes shade a light of ``kind`` (``SHADING_FORMS``; the spread
+    option keeps the form: core/light_spread.py)."""
+    return SHADING_FORMS[split_kind(kind)[0]]
 
 #: Build-time options of a light kind ("quad+range", "disk+cone+range"): each adds its falloff, and its driver
 #: inputs, to the light's data function (``light_data``); a light without them carries no node of them.
-LIGHT_OPTIONS = ("cone", "range")
-#: The base kinds each option applies to (quad_spot has its cone built in; the sun has no distance).
-OPTION_KINDS = {"cone": ("quad", "disk"), "range": ("quad", "disk", "point", "spot", "quad_spot")}
+LIGHT_OPTIONS = ("cone", "range", "spread", "linking")
+#: The base kinds each option applies to (quad_spot has its cone built in; the sun has no distance).  "spread":
+#: Blender's area-light spread below 180 deg (core/light_spread.py); the quad-to-spot fallback has none.
+OPTION_KINDS = {"cone": ("quad", "disk"), "range": ("quad", "disk", "point", "spot", "quad_spot", "sphere",
+                                                    "spot_sphere"),
+                "spread": ("quad", "disk"),
+                # Blender's light linking, where a material's objects differ in receiving the light: an input
+                # "Excluded" per object (addon/materials.py feeds it from an object attribute)
+                "linking": ("quad", "disk", "point", "spot", "sun", "quad_spot", "sphere", "spot_sphere", "sun_disk")}
 _OPTION_SEPARATOR = "+"
 
 
@@ -480,18 +785,46 @@ _RANGE_SOCKET = {"Range": scalar(10.0, "Range r of the windowed falloff saturate
                                  subtype="DISTANCE", panel=_DATA_PANEL)}
 
 
+_SPREAD_SOCKET = {"Spread": scalar(np.pi, "Spread angle of the area light (light data spread; core/light_spread.py)",
+                                   0.0, np.pi, subtype="ANGLE", panel=_DATA_PANEL)}
+_NORMAL = {"Normal": vector("Shading normal (world space, unit)", "NONE", hide_value=True)}
+_EXCLUDED_SOCKET = {"Excluded": factor(0.0, "1 on an object that light linking excludes from this light (the "
+                                            "object's attribute rtl_excluded_<light>), 0 where it receives it",
+                                       panel=_DATA_PANEL)}
+
+
 def control_factor(kind, position, params):
     """The falloff the options of ``kind`` apply to the light's colour at ``position`` (1.0 without options);
-    ``params``: the light's driver values (``light_data(kind)``'s inputs)."""
+    ``params``: the light's driver values (``light_data(kind)``'s inputs).  The spread is not a factor of the
+    colour alone: ``spread_geometry``."""
     base, options = split_kind(kind)
-    factor = 1.0
+    out = 1.0
     if "range" in options:
-        factor = range_falloff(position, _loc(params), params["Range"])
+        out = range_falloff(position, _loc(params), params["Range"])
     if "cone" in options:
-        apex, axis = projector_apex(_loc(params), *_rot(params), params["Scale X"], params["Scale Y"], params["Size"],
-                                    params["Size Y"], params["Cone Outer"], base)
-        factor = factor * apex_cone_falloff(position, apex, axis, params["Cone Inner"], params["Cone Outer"])
-    return factor
+        apex, axis = projector_apex(_loc(params), *_rot(params), *_scl(params), params["Size"], params["Size Y"],
+                                    params["Cone Outer"], base, params["Determinant"])
+        out = out * apex_cone_falloff(position, apex, axis, params["Cone Inner"], params["Cone Outer"])
+    if "linking" in options:
+        out = out * (1.0 - op.saturate(params["Excluded"]))
+    return out
+
+
+def spread_geometry(base, light, position, normal, spread):
+    """The outputs of a quad or disk light's data function (``light``) with Blender's spread applied
+    (core/light_spread.py): the clamped region's geometry and the radiance times the spread's factor."""
+    if base == "quad":
+        centre = light["Center"]
+        half_u, half_v = op.scale(light["p1"] - light["p0"], 0.5), op.scale(light["p3"] - light["p0"], 0.5)
+        centre, eu, ev, weight = light_spread.spread_quad(position, normal, centre, half_u, half_v, spread)
+        low, high = centre - eu, centre + eu
+        out = {"p0": low - ev, "p1": high - ev, "p2": high + ev, "p3": low + ev, "Center": centre}
+    else:
+        centre, axis_u, axis_v, weight = light_spread.spread_disk(position, normal, light["Center"], light["Axis U"],
+                                                                  light["Axis V"], spread)
+        out = {"Center": centre, "Axis U": axis_u, "Axis V": axis_v}
+    out["Radiance"] = op.scale(light["Radiance"], weight)
+    return out
 
 
 def _with_options(base, options):
@@ -501,6 +834,8 @@ def _with_options(base, options):
 
     def body(**kw):
         out = dict(data(**{k: kw[k] for k in data.input_sockets}))
+        if "spread" in options:
+            out.update(spread_geometry(base, out, kw["Position"], kw["Normal"], kw["Spread"]))
         out[color_name] = op.scale(out[color_name], control_factor(kind, kw["Position"], kw))
         return out
 
@@ -510,10 +845,17 @@ def _with_options(base, options):
         inputs.update(_cone_sockets())
     if "range" in options:
         inputs.update(_RANGE_SOCKET)
+    if "spread" in options:
+        inputs.update(_SPREAD_SOCKET)
+    if "linking" in options:
+        inputs.update(_EXCLUDED_SOCKET)
     inputs.update(_POSITION)
-    words = {"cone": "cone falloff at the projector apex", "range": "windowed range"}
+    if "spread" in options:
+        inputs.update(_NORMAL)
+    words = {"cone": "the talk's cone falloff at the projector apex", "range": "the talk's windowed range",
+             "spread": "Blender's spread", "linking": "Blender's light linking"}
     return NodeFunction(f"{data.name} ({', '.join(options)})", body, inputs, dict(data.output_sockets),
-                        f"{data.description}; with the talk's " + " and ".join(words[o] for o in options))
+                        f"{data.description}; with " + " and ".join(words[o] for o in options))
 
 
 @functools.lru_cache(maxsize=None)
@@ -524,27 +866,35 @@ def light_data(kind):
 
 
 #: The data functions of one light of each kind with every option it takes (what tests check in each backend).
-CONTROL_FUNCTIONS = tuple(light_data(kind_name(k, LIGHT_OPTIONS)) for k in ("quad", "disk", "point", "spot", "quad_spot"))
+CONTROL_FUNCTIONS = tuple(light_data(kind_name(k, LIGHT_OPTIONS)) for k in LIGHT_DATA)
 
-_DATA_PATHS = {"Power": "energy", "Strength": "energy", "Color R": "color[0]", "Color G": "color[1]",
-               "Color B": "color[2]", "Size": "size", "Size Y": "size_y", "Spot Size": "spot_size",
-               "Spot Blend": "spot_blend",
+_DATA_PATHS = {"Power": "energy", "Strength": "energy", "Size": "size", "Size Y": "size_y", "Spot Size": "spot_size",
+               "Spot Blend": "spot_blend", "Exposure": "exposure", "Normalize": "normalize",
+               "Radius": "shadow_soft_size", "Soft Falloff": "use_soft_falloff", "Angle": "angle", "Spread": "spread",
                # the light controls: custom properties of the light data (addon/light_controls.py registers them)
                "Range": '["rtl_range"]', "Cone Inner": '["rtl_cone_inner"]', "Cone Outer": '["rtl_cone_outer"]'}
 
 
 def driver_sources(kind, shape=None):
     """Where each input of ``light_data(kind)`` comes from in Blender, as the driver that feeds it:
-    ("transform", TRANSFORMS channel in world space) or ("data", light data path).  SQUARE and DISK
-    lights have one size: their "Size Y" reads ``size`` too (Cycles ignores size_y for them)."""
+    ("transform", TRANSFORMS channel in world space), ("data", light data path), ("color", channel) for the
+    light's colour (the product of its colours: addon/materials.py), ("determinant", None) for its world
+    matrix's determinant or ("excluded", None) for the linking option's object attribute.  SQUARE and DISK lights have one size: their "Size Y" reads ``size`` too (Cycles
+    ignores size_y for them)."""
     out = {}
     for name in light_data(kind).input_sockets:
-        if name == "Position":
+        if name in SHADING_POINT_INPUTS:
             continue
         word, _, axis = name.partition(" ")
         if word in ("Location", "Rotation", "Scale") and len(axis) == 1:
             prefix = {"Location": "LOC_", "Rotation": "ROT_", "Scale": "SCALE_"}[word]
             out[name] = ("transform", prefix + axis)
+        elif word == "Color" and len(axis) == 1:
+            out[name] = ("color", "RGB".index(axis))
+        elif name == "Excluded":
+            out[name] = ("excluded", None)
+        elif name == "Determinant":
+            out[name] = ("determinant", None)
         elif name == "Size Y" and shape in ("SQUARE", "DISK"):
             out[name] = ("data", "size")
         else:

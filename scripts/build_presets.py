@@ -17,7 +17,7 @@ def main(argv):
     from rt_lookdev.addon import preset_assets as presets
     from rt_lookdev.core.materials import presets as core_presets
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=presets.ASSETS_DIR)
     args = parser.parse_args(argv)
     bpy.ops.wm.read_homefile(use_empty=True)

@@ -1,8 +1,8 @@
 """Write the RT Lit material's shaders for an engine: GLSL 4.50, GLSL ES 3.00 and HLSL fragment and
 vertex shaders, the uniform interface (interface.json) and the LUT files they sample.
 
-    python scripts/export_shader.py --out DIR [--specular turquin] [--diffuse cod] [--sheen] [--cloth]
-                                    [--lights quad,disk,point,spot,sun] [--dialects glsl450,glsl300es,hlsl]
+    python scripts/export_shader.py --out DIR [--specular turquin] [--diffuse cod] [--sheen [zeltner]] [--cloth]
+                                    [--lights quad+cone+range,disk,point,spot,sun] [--dialects glsl450,glsl300es,hlsl]
                                     [--world ENV.exr --world-table NAME] [--no-precise] [--lut-dir DIR]
 
 Entry point of ``rt_lookdev.core.export.shaders``; ``--help`` lists the options."""

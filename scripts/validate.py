@@ -7,6 +7,8 @@ from rt_lookdev.validation import suite
 
 
 def main(argv):
+    if "--" in argv:                      # blender --background --python x.py -- args
+        argv = argv[argv.index("--") + 1:]
     args = suite.parse_args(argv)
     return 0 if suite.run(args)["passed"] else 1
 

@@ -2,7 +2,8 @@
 candidate models (Lambert, Fujii's Oren-Nayar, EON, Cycles' variant).
 
     python scripts/validate_rough_diffuse.py [--resolution N] [--samples S] [--out DIR]
-    bash scripts/test.sh --release 4.5 ... / .venvs/blender-4.5/bin/python scripts/validate_rough_diffuse.py
+    .venvs/blender-4.5/bin/python scripts/validate_rough_diffuse.py [same options]   (Blender 4.5's Cycles; the
+                                                     venv is built by bash scripts/test.sh --release 4.5)
 
 Entry point of ``rt_lookdev.validation.rough_diffuse_furnace``; ``--help`` lists the options."""
 import sys

@@ -7,6 +7,8 @@ from rt_lookdev.validation import world_suite
 
 
 def main(argv):
+    if "--" in argv:                      # blender --background --python x.py -- args
+        argv = argv[argv.index("--") + 1:]
     args = world_suite.parse_args(argv)
     return 0 if world_suite.run(args)["passed"] else 1
 

@@ -39,7 +39,8 @@ def _light_params(size, size_y, outer, inner, height, power=100.0):
     return {"Location X": 0.0, "Location Y": 0.0, "Location Z": height, "Rotation W": 1.0, "Rotation X": 0.0,
             "Rotation Y": 0.0, "Rotation Z": 0.0, "Scale X": 1.0, "Scale Y": 1.0, "Scale Z": 1.0, "Power": power,
             "Color R": 1.0, "Color G": 1.0, "Color B": 1.0, "Size": size, "Size Y": size_y,
-            "Cone Inner": math.radians(inner), "Cone Outer": math.radians(outer)}
+            "Cone Inner": math.radians(inner), "Cone Outer": math.radians(outer), "Exposure": 0.0, "Normalize": 1.0,
+            "Determinant": 1.0}
 
 
 def _floor(points, height):
@@ -81,8 +82,9 @@ def talk_readings(pos, params, albedo=1.0):
     from ..core import lights
 
     loc = np.array([params["Location X"], params["Location Y"], params["Location Z"]])
-    apex, axis = lights.projector_apex(loc, 1.0, 0.0, 0.0, 0.0, params["Scale X"], params["Scale Y"], params["Size"],
-                                       params["Size Y"], params["Cone Outer"], "quad")
+    apex, axis = lights.projector_apex(loc, 1.0, 0.0, 0.0, 0.0, params["Scale X"], params["Scale Y"],
+                                       params.get("Scale Z", 1.0), params["Size"], params["Size Y"],
+                                       params["Cone Outer"], "quad")
     d = apex - pos
     dist2 = np.maximum(np.sum(d * d, -1), lights.MIN_DISTANCE ** 2)
     l = d / np.sqrt(np.sum(d * d, -1))[:, None]
@@ -174,7 +176,7 @@ def markdown(result):
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="docs/benchmarks", help="folder for light_fallback.md / .json")
     p.add_argument("--quick", action="store_true", help="a coarser floor")
     p.add_argument("--lut-dir", default=None)

@@ -297,7 +297,7 @@ def format_markdown(r):
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--objects", type=int, nargs="+", default=[100, 1000])
     p.add_argument("--lights", type=int, default=10)
     p.add_argument("--repeats", type=int, default=200)

@@ -87,7 +87,7 @@ def numpy_radiance(scene, passes, tables):
     """The RT Lit materials evaluated directly in numpy (float64, ``core.materials.rt_lit.rt_lit_radiance``
     with the LUT set ``tables``) at the render's pixels, and the mask of pixels that hit a sphere.  Each
     pixel's material is found by the sphere it lies on."""
-    from ..addon import materials
+    from ..addon import light_model, materials
     from ..addon import world_sync as rtl_world
     from ..addon.common import FEATURES_KEY
     from ..core.materials import rt_lit
@@ -98,7 +98,7 @@ def numpy_radiance(scene, passes, tables):
     nrm = passes["Normal"].astype(np.float64)
     hit = np.linalg.norm(nrm, axis=-1) > 0.5
     out = np.zeros(pos.shape)
-    lights = [(kind, materials.light_parameters(obj, kind)) for obj, kind in materials.scene_lights(scene)]
+    scene_lights = materials.scene_lights(scene)
     env = rtl_world.world_environment()
     world = None if env is None else (env[0], rtl_world.world_parameters(scene))
     for obj in scene.objects:
@@ -112,5 +112,6 @@ def numpy_radiance(scene, passes, tables):
         params = {k: (np.array(v) if isinstance(v, tuple) else v)
                   for k, v in materials.material_parameters(mat).items()}
         geo = {"Position": pos[mine], "Geometry Normal": nrm[mine], "Incoming": camera_incoming(scene, pos[mine])}
+        lights = [(kind, light_model.light_parameters(light, kind, obj)) for light, kind in scene_lights]
         out[mine] = rt_lit.rt_lit_radiance(tables, features, params, geo, lights, world)
     return out, hit

@@ -449,7 +449,7 @@ def write_markdown(res, path):
 
 def parse_args(argv):
     """The options of scripts/benchmark_ltc.py parsed from ``argv``."""
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks")
     p.add_argument("--lut-dir", type=Path, default=catalog.default_lut_dir())
     p.add_argument("--repeats", type=int, default=3)

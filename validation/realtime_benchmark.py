@@ -73,11 +73,11 @@ def _light(kind, k, count):
     y = np.cross(z, x)
     w, qx, qy, qz = _quaternion(np.stack([x, y, z], axis=1))
     params = {"Rotation W": w, "Rotation X": qx, "Rotation Y": qy, "Rotation Z": qz,
-              "Color R": 1.0, "Color G": 0.9, "Color B": 0.8}
+              "Color R": 1.0, "Color G": 0.9, "Color B": 0.8, "Exposure": 0.0, "Normalize": 1.0}
     if kind != "sun":
         params.update({"Location X": loc[0], "Location Y": loc[1], "Location Z": loc[2]})
-    if kind in ("quad", "disk", "spot"):
-        params.update({"Scale X": 1.0, "Scale Y": 1.0, "Scale Z": 1.0})
+    if kind in ("quad", "disk", "spot", "sun"):
+        params.update({"Scale X": 1.0, "Scale Y": 1.0, "Scale Z": 1.0, "Determinant": 1.0})
     if kind in ("quad", "disk"):
         params.update({"Power": 200.0, "Size": 1.0, "Size Y": 0.6})
     elif kind == "point":

@@ -78,10 +78,10 @@ class RealtimeRenderer:
                 f"{shader.material.name}: the driver ({glsl_runner.available()[1]}) refused the shader: {exc}\n"
                 + glsl_runner.numbered(shader.fragment)) from exc
 
-    def _set_uniforms(self, program, shader, material_values):
+    def _set_uniforms(self, program, shader, material_values, obj):
         scene = self.scene
         world = scene.world.parameters if scene.world is not None else None
-        values = shader.uniform_values(material_values, [light.parameters for light in scene.lights], world)
+        values = shader.uniform_values(material_values, obj.light_values(scene.lights), world)
         cam = scene.camera
         values.update({"u_camera_position": tuple(cam.position), "u_camera_forward": tuple(cam.forward),
                        "u_camera_orthographic": 1.0 if cam.type == "ORTHO" else 0.0})
@@ -108,7 +108,7 @@ class RealtimeRenderer:
         ctx.disable(ctx.CULL_FACE)
         self.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         for obj, key, vao in self.meshes:
-            self._set_uniforms(self.programs[key], self.shaders[key], self.scene.materials[obj.material].inputs)
+            self._set_uniforms(self.programs[key], self.shaders[key], self.scene.materials[obj.material].inputs, obj)
             vao.render(ctx.TRIANGLES)
 
     def frame_seconds(self):

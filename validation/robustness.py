@@ -28,14 +28,17 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..core import lights as light_math
+from ..core import light_spread, lights as light_math
 from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import RADIANCE_OUTPUT, Features
 
 #: The five Blender light kinds, then the talk's light controls (core/lights.py): range and cone on area lights,
-#: and the quad-to-spot fallback with a range.
-LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad+cone+range", "disk+cone+range", "quad_spot+range")
-AREA_KINDS = ("quad", "disk")
+#: and the quad-to-spot fallback with a range; then Blender's light model (issue 27): point and spot lights with a
+#: radius, suns with an angle, area lights with a spread, light linking.
+LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad+cone+range", "disk+cone+range", "quad_spot+range",
+               "sphere", "spot_sphere+range+linking", "sun_disk", "quad+spread", "disk+spread+linking")
+#: The kinds whose unit is an emitted radiance (their lobes integrate over a quad or a disk).
+AREA_KINDS = ("quad", "disk", "sphere", "spot_sphere", "sun_disk")
 #: Allowed excess over the white-furnace bound (relative): float32 rounding and bilinear lookups.
 BOUND_TOLERANCE = 1e-3
 #: Views this close to the tangent plane may fall on either side of the back-facing switch.
@@ -215,7 +218,9 @@ def _light_values(rng, kind, position, normal, n):
     vals = {"Location X": location[:, 0], "Location Y": location[:, 1], "Location Z": location[:, 2],
             "Rotation W": rotation[:, 0], "Rotation X": rotation[:, 1], "Rotation Y": rotation[:, 2],
             "Rotation Z": rotation[:, 3], "Scale X": scale[:, 0], "Scale Y": scale[:, 1], "Scale Z": scale[:, 2],
-            "Power": power, "Strength": power, "Color R": np.ones(n), "Color G": np.ones(n), "Color B": np.ones(n)}
+            "Power": power, "Strength": power, "Color R": np.ones(n), "Color G": np.ones(n), "Color B": np.ones(n),
+            # a mirrored world matrix (its determinant's sign; the drivers give positive scales: core/lights.py)
+            "Determinant": np.where(rng.random(n) < 0.1, -1.0, 1.0) * np.prod(np.abs(scale), axis=-1)}
     size = _mix_special(rng, _log_uniform(rng, 1e-6, 1e6, n), [0.0], 0.03)
     # rectangles and ellipses up to 1:1000 (a strip light); thinner ones are a known limit (KNOWN_LIMITS)
     aspect = _log_uniform(rng, 1.0, ASPECT_MAX, n) ** rng.choice([-1.0, 1.0], n)
@@ -229,31 +234,56 @@ def _light_values(rng, kind, position, normal, n):
                  # the light controls: ranges from 1 mm to 1000 km and 0 (off), cone angles from 0 to pi
                  "Range": _mix_special(rng, _log_uniform(rng, 1e-3, 1e6, n), [0.0], 0.03),
                  "Cone Inner": _mix_special(rng, rng.uniform(0, np.pi, n), [0.0, np.pi], 0.05),
-                 "Cone Outer": _mix_special(rng, rng.uniform(0, np.pi, n), [0.0, np.pi], 0.05)})
+                 "Cone Outer": _mix_special(rng, rng.uniform(0, np.pi, n), [0.0, np.pi], 0.05),
+                 # Blender's light model: exposure over and beyond its range (clamped to +-32), Normalize and Soft
+                 # Falloff on or off, radii from 1 um to 1 km and 0, angles and spreads over [0, pi] with both ends
+                 "Exposure": _mix_special(rng, rng.uniform(-10, 10, n), [-32.0, 32.0, -1e4, 1e4], 0.05),
+                 "Normalize": (rng.random(n) < 0.8).astype(np.float64),
+                 "Radius": _mix_special(rng, _log_uniform(rng, 1e-6, 1e3, n), [0.0], 0.03),
+                 "Soft Falloff": (rng.random(n) < 0.5).astype(np.float64),
+                 "Angle": _mix_special(rng, rng.uniform(0, np.pi, n), [0.0, np.pi], 0.05),
+                 "Spread": _mix_special(rng, rng.uniform(0, np.pi, n), [0.0, np.pi], 0.05),
+                 "Excluded": _mix_special(rng, (rng.random(n) < 0.5).astype(np.float64), [0.5], 0.05)})
     params = rt_lit.light_parameters(kind)
     return {p: vals[p] for p in params}, _unit_light(kind, vals, position)
 
 
 def _unit_light(kind, vals, position):
-    """What one unit of the light is at the point (float64): the emitted radiance of an area light, the
-    irradiance at normal incidence of a point, spot or sun light (white light); a light's options (range, cone)
-    only attenuate it.  The quad-to-spot fallback: its on-axis intensity P / pi over the squared distance."""
-    kind = light_math.base_kind(kind)
+    """What one unit of the light is at the point (float64): the emitted radiance of an area light (its peak
+    radiance with a spread: core/light_spread.py), the irradiance at normal incidence of a point, spot or sun
+    light (white light), with its exposure and Normalize; a light's options (range, cone, linking) only attenuate
+    it.  The quad-to-spot fallback: its on-axis intensity L A over the squared distance."""
+    base, options = light_math.split_kind(kind)
     with np.errstate(all="ignore"):
-        if kind == "quad_spot":
-            loc = np.stack([vals["Location X"], vals["Location Y"], vals["Location Z"]], -1)
-            d2 = np.maximum(((loc - position) ** 2).sum(-1), light_math.MIN_DISTANCE ** 2)
-            return vals["Power"] / (np.pi * d2)
-        if kind in AREA_KINDS:
-            half_u = np.abs(vals["Scale X"] * vals["Size"]) * 0.5
-            half_v = np.abs(vals["Scale Y"] * vals["Size Y"]) * 0.5
-            area = half_u * half_v * (4.0 if kind == "quad" else np.pi)
-            return np.where(area > light_math.AREA_MIN, vals["Power"] / (np.pi * np.maximum(area, 1e-300)), 0.0)
-        if kind == "sun":
-            return vals["Strength"]
+        power = vals["Power"] * np.exp2(np.clip(vals["Exposure"], *light_math.EXPOSURE_RANGE))
+        strength = vals["Strength"] * np.exp2(np.clip(vals["Exposure"], *light_math.EXPOSURE_RANGE))
+        normalized = vals["Normalize"] > 0.5
+
+        def per_area(area, flux):
+            return np.where(area > light_math.AREA_MIN, flux / np.where(normalized, np.maximum(area, 1e-300), 1.0), 0.0)
+
         loc = np.stack([vals["Location X"], vals["Location Y"], vals["Location Z"]], -1)
         d2 = np.maximum(((loc - position) ** 2).sum(-1), light_math.MIN_DISTANCE ** 2)
-        return vals["Power"] / (4.0 * np.pi * d2)
+        half_u = np.abs(vals["Scale X"] * vals["Size"]) * 0.5
+        half_v = np.abs(vals["Scale Y"] * vals["Size Y"]) * 0.5
+        if base == "quad_spot":
+            area = 4.0 * half_u * half_v
+            return per_area(area, power / np.pi) * area / d2
+        if base in ("quad", "disk"):
+            radiance = per_area(half_u * half_v * (4.0 if base == "quad" else np.pi), power / np.pi)
+            if "spread" in options:
+                h = np.clip(vals["Spread"] * 0.5, light_spread.MIN_HALF_SPREAD, light_spread.MAX_HALF_SPREAD)
+                peak = np.where(vals["Spread"] > np.pi - 1e-6, 1.0, np.tan(h) / (np.tan(h) - h))
+                radiance = radiance * peak
+            return radiance
+        if base in ("sphere", "spot_sphere"):
+            return per_area(4.0 * np.pi * vals["Radius"] ** 2, power / np.pi)
+        if base == "sun_disk":
+            half = np.clip(vals["Angle"] * 0.5, 0.0, 0.5 * np.pi)
+            return per_area(np.pi * np.sin(half) ** 2, strength)
+        if base == "sun":
+            return strength
+        return per_area(np.full_like(d2, light_math.POINT_AREA), power / np.pi) / d2
 
 
 def scene_inputs(family, kind, n, seed=0):

@@ -175,7 +175,7 @@ class Variant:
 
 @dataclass
 class LightSpec:
-    kind: str                       # quad, disk, point, spot, sun
+    kind: str                       # quad, disk, point, spot, sun; sphere, spot_sphere (radius > 0), sun_disk (angle > 0)
     location: tuple
     energy: float
     size: float = 1.0
@@ -186,14 +186,54 @@ class LightSpec:
     spot_blend: float = 0.3
     #: RT Lookdev's light controls (addon/light_controls.py): custom property -> value, e.g. {"rtl_use_range": True}
     controls: dict = field(default_factory=dict)
+    #: Blender's light model (issue 27): the radius of sphere lights, Soft Falloff, the sun's angle, the area light's
+    #: spread, other light data settings (exposure, normalize, use_temperature, temperature), the node tree's Emission
+    #: (strength, colour) or None, the object's scale (a mirror), and the variants light linking excludes
+    radius: float = 0.0
+    soft_falloff: bool = True
+    angle: float = 0.0
+    spread: float = math.pi
+    settings: dict = field(default_factory=dict)
+    emission: tuple | None = None
+    scale: tuple = (1.0, 1.0, 1.0)
+    excludes: tuple = ()
+
+    @property
+    def pool(self):
+        """The light's name in the pooled statistics and gates: its kind, and what of Blender's light model it shows
+        beyond it ("quad_spread", "point_units", "quad_mirrored", "point_linked")."""
+        out = self.kind
+        if self.spread < math.pi - 1e-6:
+            out += "_spread"
+        if self.settings or self.emission is not None:
+            out += "_units"
+        if any(s < 0 for s in self.scale):
+            out += "_mirrored"
+        if self.excludes:
+            out += "_linked"
+        return out
 
     def describe(self):
         x, y, z = self.location
         s = f"{self.kind} at ({x:.2f}, {y:.2f}, {z:.2f})"
         if self.kind in ("quad", "disk"):
             s += f" size {self.size:.2f}" + (f" x {self.size_y:.2f}" if self.size_y else "")
+        if self.kind in ("sphere", "spot_sphere"):
+            s += f" radius {self.radius:g} m" + ("" if self.soft_falloff else " (sphere)")
+        if self.kind == "sun_disk":
+            s += f" angle {math.degrees(self.angle):g} deg"
+        if self.spread < math.pi - 1e-6:
+            s += f" spread {math.degrees(self.spread):.0f} deg"
+        extra = [f"{k} {v:g}" if isinstance(v, float) else f"{k} {v}" for k, v in self.settings.items()]
+        if self.emission is not None:
+            extra.append(f"node tree emission {self.emission[0]:g}")
+        if any(s < 0 for s in self.scale):
+            extra.append(f"scale {tuple(self.scale)}")
+        if self.excludes:
+            extra.append(f"linking excludes spheres {list(self.excludes)}")
         on = [k[len("rtl_"):] for k, v in self.controls.items() if v is True]
-        return s + f", energy {self.energy:g}" + (f", {'/'.join(on)}" if on else "")
+        return s + f", energy {self.energy:g}" + (f", {'/'.join(on)}" if on else "") + \
+            (f", {', '.join(extra)}" if extra else "")
 
 
 @dataclass
@@ -207,7 +247,7 @@ class Case:
 
     @property
     def light_kinds(self):
-        return sorted({l.kind for l in self.lights})
+        return sorted({l.pool for l in self.lights})
 
 
 CELL = 2.2                          # world units per sphere cell
@@ -342,7 +382,63 @@ def build_cases(seed=0, quick=False):
                                       "r = 0.3, 0.6, 0.9", tags={"light": spec.kind}))
     cases += rough_diffuse_cases(cases)
     cases += sheen_cases(cases)
+    cases += light_model_cases()
     return cases
+
+
+#: The rows of the light-model cases: Cycles closures (Lambert, GGX r = 0.1 ... 1, Turquin, the dielectric and the
+#: metal) and the demo scene's techniques without one (against the integral of their BRDF over the true emitter).
+LIGHT_MODEL_ROW = [Variant("lambert"), Variant("ggx", 0.1), Variant("ggx", 0.3), Variant("ggx", 0.5),
+                   Variant("ggx", 0.8), Variant("ggx", 1.0), Variant("turquin", 0.6), Variant("dielectric", 0.4),
+                   Variant("metal", 0.5), Variant("cod", 0.5), Variant("cod_wrapped", 0.5, wrap=0.5),
+                   Variant("cloth", 0.5), Variant("kulla_conty", 0.7), Variant("zeltner", 0.5)]
+#: A shorter row for the settings that only scale or orient a light.
+LIGHT_SETTINGS_ROW = [Variant("lambert"), Variant("ggx", 0.1), Variant("ggx", 0.4), Variant("turquin", 0.7),
+                      Variant("metal", 0.5), Variant("cod", 0.5)]
+
+
+def light_model_cases():
+    """Blender's light model (issue 27): sphere lights (radius 0.05, 0.1, 0.25 m, their surfaces 1-3 m from the
+    spheres', Soft Falloff on and off), a spot with a radius, suns of angle 0.5, 2 and 10 deg, area lights with a
+    spread, exposure, temperature, Normalize off and a node tree's emission, mirrored lights and light linking."""
+    def case(name, spec, row, text):
+        return Case(name, [spec], row, columns=5 if len(row) > 6 else 3, description=f"{spec.describe()}: {text}",
+                    tags={"light": spec.pool})
+
+    full, short = LIGHT_MODEL_ROW, LIGHT_SETTINGS_ROW
+    out = [
+        case("sphere_r005", LightSpec("sphere", (1.0, -2.4, 1.3), 300.0, radius=0.05), full,
+             "sphere light (Soft Falloff), the row's techniques"),
+        case("sphere_r01_hard", LightSpec("sphere", (-1.5, -3.0, 1.6), 500.0, radius=0.1, soft_falloff=False), full,
+             "sphere light without Soft Falloff, the row's techniques"),
+        case("sphere_r025", LightSpec("sphere", (0.6, -2.3, -0.9), 250.0, radius=0.25), full,
+             "large sphere light, the row's techniques"),
+        case("spot_sphere", LightSpec("spot_sphere", (-1.0, -3.6, 1.8), 900.0, radius=0.15, spot_size=1.0,
+                                      spot_blend=0.3), short, "spot light with a radius"),
+        case("spread_quad", LightSpec("quad", (1.2, -2.8, 1.8), _area_power("quad", 2.0, None, 3.0, 4.0), 2.0,
+                                      spread=math.radians(60.0)), short, "area light with spread 60 deg"),
+        case("spread_disk", LightSpec("disk", (-1.5, -2.6, 1.2), _area_power("disk", 2.0, None, 3.0, 4.0), 2.0,
+                                      spread=math.radians(90.0)), short, "disk light with spread 90 deg"),
+        case("units_point", LightSpec("point", (1.5, -3.0, 1.5), 150.0,
+                                      settings={"exposure": 1.5, "use_temperature": True, "temperature": 4000.0,
+                                                "normalize": False}), short,
+             "exposure, temperature and Normalize off"),
+        case("units_quad", LightSpec("quad", (-1.2, -3.0, 1.5), _area_power("quad", 1.5, None, 3.0, 4.0), 1.5,
+                                     settings={"normalize": False, "exposure": -1.0}, emission=(0.5, (1.0, 0.7, 0.4))),
+             short, "Normalize off, exposure and a node tree's emission"),
+        case("mirrored_quad", LightSpec("quad", (1.0, -3.0, 1.0), _area_power("quad", 1.5, 0.8, 3.0, 4.0), 1.5, 0.8,
+                                        scale=(-1.0, 1.0, 1.0)), short, "area light mirrored in X"),
+        case("linked_point", LightSpec("point", (0.5, -3.0, 1.5), 400.0, excludes=(0, 2)), short,
+             "light linking excludes two spheres"),
+    ]
+    for c in out:
+        if c.lights[0].kind in ("quad", "disk"):
+            _keep_in_front(c.lights[0], sphere_centres(c)[0])
+    for angle in (0.5, 2.0, 10.0):
+        out.append(case(f"sun_disk_{angle:g}", LightSpec("sun_disk", (0.0, -3.0, 3.0), 2.0, target=(0.3, 0.0, -0.2),
+                                                          angle=math.radians(angle)),
+                        short, f"sun of angle {angle:g} deg"))
+    return out
 
 
 def rough_diffuse_cases(cases):
@@ -388,6 +484,47 @@ def _aim(obj, target):
     obj.rotation_quaternion = direction.to_track_quat("-Z", "Y")
 
 
+#: Blender light type of each LightSpec kind.
+_LIGHT_TYPES = {"quad": "AREA", "disk": "AREA", "point": "POINT", "spot": "SPOT", "sun": "SUN", "sphere": "POINT",
+                "spot_sphere": "SPOT", "sun_disk": "SUN"}
+
+
+def _light_object(bpy, scene, name, spec):
+    """A light object as ``spec`` describes it, linked to ``scene`` and aimed at its target."""
+    data = bpy.data.lights.new(name, _LIGHT_TYPES[spec.kind])
+    data.energy = spec.energy
+    data.color = spec.color
+    if spec.kind in ("quad", "disk"):
+        shape = {"quad": ("SQUARE", "RECTANGLE"), "disk": ("DISK", "ELLIPSE")}[spec.kind]
+        data.shape = shape[1] if spec.size_y else shape[0]
+        data.size = spec.size
+        data.size_y = spec.size_y or spec.size
+        data.spread = spec.spread
+    elif spec.kind in ("point", "spot", "sphere", "spot_sphere"):
+        data.shadow_soft_size = spec.radius if spec.kind in ("sphere", "spot_sphere") else 0.0
+        data.use_soft_falloff = spec.soft_falloff
+        if spec.kind in ("spot", "spot_sphere"):
+            data.spot_size, data.spot_blend = spec.spot_size, spec.spot_blend
+    else:
+        data.angle = spec.angle if spec.kind == "sun_disk" else 0.0
+    for key, value in spec.settings.items():
+        setattr(data, key, value)
+    if spec.emission is not None:
+        data.use_nodes = True
+        node = next(n for n in data.node_tree.nodes if n.bl_idname == "ShaderNodeEmission")
+        node.inputs["Strength"].default_value = spec.emission[0]
+        node.inputs["Color"].default_value = tuple(spec.emission[1]) + (1.0,)
+    for key, value in spec.controls.items():
+        data[key] = value
+    obj = bpy.data.objects.new(name, data)
+    obj.location = spec.location
+    obj.visible_camera = False
+    scene.collection.objects.link(obj)
+    _aim(obj, spec.target)
+    obj.scale = spec.scale
+    return obj
+
+
 def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
     """Reset the file; lights, spheres with RT Lit materials, camera.  Returns (scene, spheres)."""
     from ..addon import compat
@@ -398,29 +535,11 @@ def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
 
     bpy.ops.wm.read_homefile(use_empty=True)
     scene = bpy.context.scene
+    receivers = {}
     for i, spec in enumerate(case.lights):
-        ltype = {"quad": "AREA", "disk": "AREA"}.get(spec.kind, spec.kind.upper())
-        data = bpy.data.lights.new(f"L{i}_{spec.kind}", ltype)
-        data.energy = spec.energy
-        data.color = spec.color
-        if spec.kind in ("quad", "disk"):
-            shape = {"quad": ("SQUARE", "RECTANGLE"), "disk": ("DISK", "ELLIPSE")}[spec.kind]
-            data.shape = shape[1] if spec.size_y else shape[0]
-            data.size = spec.size
-            data.size_y = spec.size_y or spec.size
-        elif spec.kind in ("point", "spot"):
-            data.shadow_soft_size = 0.0
-            if spec.kind == "spot":
-                data.spot_size, data.spot_blend = spec.spot_size, spec.spot_blend
-        else:
-            data.angle = 0.0
-        for key, value in spec.controls.items():
-            data[key] = value
-        obj = bpy.data.objects.new(f"L{i}_{spec.kind}", data)
-        obj.location = spec.location
-        obj.visible_camera = False
-        scene.collection.objects.link(obj)
-        _aim(obj, spec.target)
+        obj = _light_object(bpy, scene, f"L{i}_{spec.kind}", spec)
+        if spec.excludes:
+            receivers[i] = obj.light_linking.receiver_collection = bpy.data.collections.new(f"L{i} receivers")
     materials.sync_scene_lights(scene)
 
     centres, cols, rows = sphere_centres(case)
@@ -441,6 +560,12 @@ def build_scene(case, cell_px, segments=192, rings=96, lut_dir=None):
             setattr(ob, attr, False)
         scene.collection.objects.link(ob)
         spheres.append(ob)
+    for i, collection in receivers.items():
+        for k in case.lights[i].excludes:
+            collection.objects.link(spheres[k])
+            collection.collection_objects[len(collection.objects) - 1].light_linking.link_state = "EXCLUDE"
+    if receivers:
+        materials.sync_scene_lights(scene)          # the excluded spheres' attributes (addon/light_model.py)
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
     cam.data.type = "ORTHO"
     cam.data.sensor_fit = "HORIZONTAL"
@@ -468,10 +593,11 @@ def sphere_index(case, position, normal):
 
 # --- (b) numpy -------------------------------------------------------------------------------
 
-def scene_light_params(scene):
-    from ..addon import materials
+def scene_light_params(scene, receiver=None):
+    """[(kind, driver values)] of the scene's lights; the linking option's "Excluded" for the object ``receiver``."""
+    from ..addon import light_model, materials
 
-    return [(kind, materials.light_parameters(obj, kind)) for obj, kind in materials.scene_lights(scene)]
+    return [(kind, light_model.light_parameters(obj, kind, receiver)) for obj, kind in materials.scene_lights(scene)]
 
 
 def numpy_material(variant):
@@ -516,6 +642,7 @@ def numpy_radiance(scene, variants, objects, passes, index, tables, world=None, 
         if not mine.any():
             continue
         material = rt_lit.build_rt_lit(variant.features, tuple(kind for kind, _ in lights), env)
+        lights = scene_light_params(scene, objects[i])
         values = material_values(objects[i].data.materials[0])
         values.update({"Position": pos[mine], "Geometry Normal": nrm[mine],
                        "Incoming": camera_incoming(scene, pos[mine])})
@@ -676,16 +803,45 @@ def render_truth(case, scene, spheres, samples, seeds, folder, threads=2):
 
 # --- (c) brute-force ground truth -------------------------------------------------------------
 
-def _area_geometry(kind, params):
-    """The area light's geometry and radiance (without its options' falloff: ``core.lights.control_factor``)."""
+def _area_geometry(kind, params, position=None):
+    """The light's true emitter, as Cycles samples it, for the brute-force integral: geometry and radiance without
+    its options' falloff (``core.lights.control_factor``) and without the spread (its weight is taken per direction:
+    ``_direction_weight``); a sphere light's or a sun's disk facing ``position``, a spot sphere's without its cone
+    (taken per direction too)."""
     from ..core import lights as core_lights
 
-    data = core_lights.LIGHT_DATA[core_lights.base_kind(kind)]
-    out = data(**{k: np.float64(v) for k, v in params.items() if k in data.input_sockets})
-    out = {k: np.asarray(v, np.float64) for k, v in out.items()}
-    if kind == "quad":
+    base = core_lights.base_kind(kind)
+    data = core_lights.LIGHT_DATA["sphere" if base == "spot_sphere" else base]
+    args = {k: np.float64(v) for k, v in params.items() if k in data.input_sockets}
+    if "Position" in data.input_sockets:
+        args["Position"] = np.asarray(position, np.float64)
+    out = {k: np.asarray(v, np.float64) for k, v in data(**args).items()}
+    if "p0" in out:
         return {"corners": np.stack([out[f"p{i}"] for i in range(4)]), "radiance": out["Radiance"]}
     return {"center": out["Center"], "u": out["Axis U"], "v": out["Axis V"], "radiance": out["Radiance"]}
+
+
+def _direction_weight(kind, params, position, dirs, light_normal):
+    """What Cycles multiplies the radiance of each direction ``dirs`` (from ``position`` towards the light) by: the
+    spread's weight (kernel/light/area.h ``area_light_spread_attenuation``, core/light_spread.py) and a spot
+    sphere's cone attenuation of the direction (kernel/light/spot.h); 1 for the other lights."""
+    from ..core import light_spread, lights as core_lights
+
+    base, options = core_lights.split_kind(kind)
+    weight = np.ones(len(dirs))
+    if "spread" in options:
+        h = float(np.clip(params["Spread"] * 0.5, light_spread.MIN_HALF_SPREAD, light_spread.MAX_HALF_SPREAD))
+        if params["Spread"] < np.pi - 1e-6:
+            cos_a = np.clip(dirs @ light_normal, 1e-12, 1.0)
+            tan_a = np.sqrt(np.maximum(1.0 - cos_a * cos_a, 0.0)) / cos_a
+            weight *= np.maximum(1.0 - tan_a / np.tan(h), 0.0) * np.tan(h) / (np.tan(h) - h)
+    if base == "spot_sphere":
+        loc = np.array([params["Location X"], params["Location Y"], params["Location Z"]])
+        if np.sum((loc - position) ** 2) > params["Radius"] ** 2:
+            c = core_lights.spot_cosine(position, position + dirs, *(params[f"Rotation {a}"] for a in "WXYZ"),
+                                        *(params[f"Scale {a}"] for a in "XYZ"), params["Determinant"])
+            weight *= core_lights.spot_attenuation(c, params["Spot Size"], params["Spot Blend"])
+    return weight
 
 
 def _rule(kind, geo, p, clip_normal, panels, order):
@@ -726,11 +882,12 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
     from ..core.materials import light_shading
     from .engines import camera_incoming
 
+    import bpy
+
     pos = passes["Position"].astype(np.float64)
     nrm = passes["Normal"].astype(np.float64)
     img = np.full(pos.shape, np.nan)
     qerr = np.full(pos.shape, np.nan)
-    lights = scene_light_params(scene)
     seconds = {}
     levels = (panels, max(panels // 2, 1))
     for i, variant in enumerate(case.variants):
@@ -743,6 +900,7 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
             ys, xs = ys[pick], xs[pick]
         features = variant.features
         material = numpy_material(variant)
+        lights = scene_light_params(scene, bpy.data.objects.get(f"RTL_val_sphere_{i}"))
         shade = functools.partial(light_shading.shade_function("sun", features), tables)
         unclipped = features.diffuse in ("wrapped", "cod_wrapped")
         P = pos[ys, xs]
@@ -751,8 +909,10 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
         surface = _surface(features, material, N, V)
         sums = np.zeros((len(levels), len(ys), 3))
         for kind, params in lights:
-            if core_lights.base_kind(kind) in ("quad", "disk"):
-                geo = _area_geometry(kind, params)
+            form = core_lights.shading_form(kind)
+            if form in ("quad", "disk"):
+                facing = "Position" in core_lights.LIGHT_DATA[core_lights.base_kind(kind)].input_sockets
+                geo = None if facing else _area_geometry(kind, params)
                 # the options' falloff is constant over the light for one shading point
                 control = np.broadcast_to(np.asarray(core_lights.control_factor(
                     kind, P, {k: np.float64(v) for k, v in params.items()}), np.float64), (len(ys),))
@@ -760,14 +920,17 @@ def brute_force_radiance(case, scene, passes, index, pixel_cap, rng, tables, pan
                     for start in range(0, len(ys), chunk):
                         owner, dirs, irr = [], [], []
                         for k in range(start, min(start + chunk, len(ys))):
-                            rule = _rule(kind, geo, P[k], None if unclipped else N[k], level, order)
+                            light = _area_geometry(kind, params, P[k]) if facing else geo
+                            rule = _rule(form, light, P[k], None if unclipped else N[k], level, order)
                             if rule is None or len(rule[1]) == 0:
                                 continue
                             xr, w, ln = rule
                             r = np.linalg.norm(xr, axis=-1)
+                            unit = xr / r[:, None]
+                            weight = _direction_weight(kind, params, P[k], unit, ln)
                             owner.append(np.full(len(w), k))
-                            dirs.append(xr / r[:, None])
-                            irr.append((w * np.abs(xr @ ln) / r ** 3)[:, None] * geo["radiance"] * control[k])
+                            dirs.append(unit)
+                            irr.append((w * weight * np.abs(xr @ ln) / r ** 3)[:, None] * light["radiance"] * control[k])
                         if owner:
                             owner = np.concatenate(owner)
                             rad = _shade(shade, surface, owner, np.concatenate(dirs), np.concatenate(irr))

@@ -92,7 +92,7 @@ def markdown(res, intro=()):
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("before", type=Path)
     p.add_argument("after", type=Path)
     p.add_argument("--techniques", nargs="*", default=list(GGX_TECHNIQUES))

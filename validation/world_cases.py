@@ -1,6 +1,6 @@
 """The cases of scripts/validate_world.py: the RT Lit World term under Blender's studio HDRIs.
 
-Everything here is the world counterpart of scripts/validation_suite.py (whose metrics, closure
+Everything here is the world counterpart of validation/suite_cases.py (whose metrics, closure
 materials and render settings are reused): unit spheres seen by camera rays only (no shadows, no
 sphere lights another, so each is convex and unoccluded) and an orthographic camera looking along +Y,
 lit by a World whose Background shows an equirectangular image:
@@ -45,7 +45,7 @@ import numpy as np
 from ..core.materials.rt_lit_interface import Features
 from .suite_cases import Variant
 
-CELL = 2.2                          # world units per sphere cell (validation_suite.CELL)
+CELL = 2.2                          # world units per sphere cell (suite_cases.CELL)
 BLOCK_GAP = 60.0                    # the truth block sits this far below the node block (Z)
 SPECULAR_ROUGHNESS = (0.1, 0.25, 0.5, 0.75, 1.0)
 FURNACE_ROUGHNESS = (0.0, 0.25, 0.5, 0.75, 1.0)
@@ -92,7 +92,7 @@ def rough_diffuse_variants():
 
 
 def technique_material(technique, roughness):
-    """RT Lit input values (validation_suite.technique_material): white Lambert / CoD (built without
+    """RT Lit input values (suite_cases.technique_material): white Lambert / CoD (built without
     specular: ``TECHNIQUES``), or a white metal (F0 = 1, no diffuse) for the specular techniques."""
     from . import suite_cases as suite
 
@@ -511,7 +511,7 @@ def cell_alignment(block_a, normal_a, i, block_c, normal_c, j):
 
 def max_fraction(c, mask, floor_frac):
     """The floor ``floor_frac`` x median(c) over the mask's values, as a fraction of their max (what
-    validation_suite.truth_metrics and validate._rel_values take).  Under an environment the max is a
+    suite_cases.truth_metrics and suite._rel_values take).  Under an environment the max is a
     sun's highlight, hundreds of times the typical value, so a max-relative floor would keep only the
     highlight; the median-relative floor keeps every value but the nearly black ones."""
     cv = np.asarray(c, np.float64)[mask].ravel()

@@ -3,7 +3,7 @@
 For every studio HDRI shipped in the bpy wheel (core/environment/equirect.py ``studio_hdris``; none is
 copied into the repository), plus one rotated and scaled world (Mapping node Euler XYZ rotation,
 Background strength), a node block of unit spheres with RT Lit materials and a truth block of Cycles
-closures are rendered (scripts/validation_world.py describes the scene):
+closures are rendered (validation/world_cases.py describes the scene):
 
   (a) node render: Cycles, 1 sample at pixel centres, the RT Lit material with its World term;
   (b) numpy: the same IR (core/materials/rt_lit.py with ``world=``) at (a)'s Position / Normal passes;

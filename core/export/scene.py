@@ -149,11 +149,18 @@ class SceneMaterial:
 
 @dataclass
 class SceneObject:
-    """A mesh object drawn with ``material``; its triangles are in geometry.npz under key ``key``."""
+    """A mesh object drawn with ``material``; its triangles are in geometry.npz under key ``key``;
+    ``excluded_lights``: the lights Blender's light linking keeps from it (their "Excluded" is 1 when it is drawn)."""
     name: str
     material: str
     key: str
     triangles: int = 0
+    excluded_lights: list = field(default_factory=list)
+
+    def light_values(self, lights):
+        """The parameters of ``lights`` (SceneLights) as this object is drawn with them."""
+        return [dict(light.parameters, Excluded=1.0) if light.name in self.excluded_lights else light.parameters
+                for light in lights]
 
 
 @dataclass

@@ -14,7 +14,6 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
-import sys
 from pathlib import Path
 
 from ..lut import catalog
@@ -29,7 +28,7 @@ def interface(shader):
     """The uniform interface of a ``MaterialShader`` as plain data."""
     return {"material": shader.material.name, "features": shader.material.features.as_dict(),
             "light_slots": [{"kind": kind, "uniform": f"{rt_lit_shader.light_array(kind)}[{index}]",
-                             "struct": rt_lit_shader.LIGHT_STRUCTS[kind],
+                             "struct": rt_lit_shader.light_struct(kind),
                              "fields": [{"field": f, "type": t, "parameters": [p for p, _ in parts]}
                                         for f, t, parts in rt_lit_shader.light_fields(kind)]}
                             for kind, index in shader.light_slots],
@@ -76,47 +75,83 @@ def write_material_shaders(folder, material, dialects=tuple(EXTENSIONS), luts=No
     return written
 
 
+def _light_kinds(text):
+    """--lights: the kinds in order ("quad,disk+cone+range"); a bad one is argparse's error, naming the valid ones."""
+    from ..lights import OPTION_KINDS, split_kind
+
+    kinds = tuple(k for k in text.split(",") if k)
+    for kind in kinds:
+        try:
+            split_kind(kind)
+        except ValueError as exc:
+            options = "; ".join(f"+{o} on {', '.join(bases)}" for o, bases in OPTION_KINDS.items())
+            raise argparse.ArgumentTypeError(f"{exc}; the options, in this order: {options} "
+                                             "(quad+cone+range)") from None
+    return kinds
+
+
+def _dialects(text):
+    """--dialects: one or more of ``EXTENSIONS``, comma-separated."""
+    dialects = tuple(d for d in text.split(",") if d)
+    unknown = [d for d in dialects if d not in EXTENSIONS]
+    if unknown or not dialects:
+        what = f"unknown dialects {', '.join(unknown)}" if unknown else "no dialect"
+        raise argparse.ArgumentTypeError(f"{what}; choose from {', '.join(EXTENSIONS)}")
+    return dialects
+
+
+#: What --world takes, for its errors.
+_WORLD_FILE = "a world bake's prefiltered EXR (<name>_ggx_prefiltered.exr of python scripts/bake_environment.py)"
+
+
+def _world(parser, path, table):
+    """The --world environment, or the parser's one-line error saying what is wrong with the file."""
+    from ..lut.exr_io import LutError
+    from ..materials.world_shading import WorldEnvironment
+
+    if not path.is_file():
+        parser.error(f"argument --world: {path} does not exist; it takes {_WORLD_FILE}")
+    try:
+        return WorldEnvironment.load(path, table or path.stem)
+    except (LutError, ValueError) as exc:
+        parser.error(f"argument --world: {path} is not {_WORLD_FILE}: {exc.__cause__ or exc}")
+
+
 def parse_args(argv):
-    """The options of scripts/export_shader.py."""
-    from ..materials.rt_lit_interface import DIFFUSE_MODELS, LIGHT_KINDS, SPECULAR_MODELS
+    """The options of scripts/export_shader.py, checked: a bad one ends in argparse's one-line error (exit code 2).
+    ``environment``: the --world file loaded (a ``WorldEnvironment``), or None."""
+    from ..materials.rt_lit_interface import (DIFFUSE_MODELS, LIGHT_KINDS, PRINCIPLED_SHEEN, SHEEN_MODELS,
+                                              SPECULAR_MODELS)
 
     p = argparse.ArgumentParser(description="Write the RT Lit material's shaders, interface and tables for an engine")
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--specular", default="turquin", choices=SPECULAR_MODELS)
     p.add_argument("--diffuse", default="cod", choices=DIFFUSE_MODELS)
-    p.add_argument("--sheen", action="store_true")
+    p.add_argument("--sheen", nargs="?", default="none", const=PRINCIPLED_SHEEN, choices=SHEEN_MODELS,
+                   help=f"the sheen model (default none); --sheen alone: {PRINCIPLED_SHEEN}, Principled's sheen, as "
+                        "Convert gives a Principled material with sheen (the talk's Disney sheen is disney_talk)")
     p.add_argument("--cloth", action="store_true")
-    p.add_argument("--lights", default="quad,disk", help=f"light kinds in order, from {', '.join(LIGHT_KINDS)}; options as quad+cone+range")
-    p.add_argument("--dialects", default=",".join(EXTENSIONS))
+    p.add_argument("--lights", type=_light_kinds, default="quad,disk",
+                   help=f"light kinds in order, from {', '.join(LIGHT_KINDS)}; options as quad+cone+range")
+    p.add_argument("--dialects", type=_dialects, default=",".join(EXTENSIONS),
+                   help=f"comma-separated, from {', '.join(EXTENSIONS)} (default: all)")
     p.add_argument("--world", type=Path, default=None, help="a prefiltered environment EXR (a world bake)")
     p.add_argument("--world-table", default=None, help="its table name (default: the file's stem)")
     p.add_argument("--no-precise", action="store_true", help="let the compiler fuse and reorder arithmetic")
     p.add_argument("--lut-dir", type=Path, default=None)
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    args.environment = _world(p, args.world, args.world_table) if args.world else None
+    return args
 
 
 def run_args(args, log=print):
     """scripts/export_shader.py: build the material the options name and write it; the exit code."""
     from ..materials import rt_lit
-    from ..materials.rt_lit_interface import LIGHT_KINDS, Features
-    from ..materials.world_shading import WorldEnvironment
+    from ..materials.rt_lit_interface import Features
 
-    from ..lights import LIGHT_OPTIONS, split_kind
-
-    kinds = tuple(k for k in args.lights.split(",") if k)
-    bad = []
-    for k in kinds:
-        try:
-            split_kind(k)
-        except ValueError:
-            bad.append(k)
-    if bad:
-        print(f"export_shader: unknown light kinds {bad}; choose from {', '.join(LIGHT_KINDS)}, with options "
-              f"+{' +'.join(LIGHT_OPTIONS)} (quad+cone+range)", file=sys.stderr)
-        return 2
-    env = WorldEnvironment.load(args.world, args.world_table or args.world.stem) if args.world else None
-    material = rt_lit.build_rt_lit(Features(args.specular, args.diffuse, args.sheen, args.cloth), kinds, env)
-    written = write_material_shaders(args.out, material, tuple(args.dialects.split(",")),
+    material = rt_lit.build_rt_lit(Features(args.specular, args.diffuse, args.sheen, args.cloth), args.lights,
+                                   args.environment)
+    written = write_material_shaders(args.out, material, args.dialects,
                                      args.lut_dir or catalog.default_lut_dir(), not args.no_precise)
     log(f"{material.name}: wrote {len(written)} files to {args.out}: {', '.join(written)}")
     return 0

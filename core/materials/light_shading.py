@@ -177,16 +177,17 @@ def shade_function(kind, features):
     options change the light's data, not its shading)."""
     color_name = light_color_name(kind)
     functions = [lobes.LOBES[key].function(kind) for key in lobe_keys(features)]
+    area = lights.shading_form(kind) != "punctual"
 
     def shade(tables, **kw):
         values = {}
         for fn in functions:
             values.update(fn(tables, **_arguments(fn, kw)))
-        return {"Radiance": combine_lobes(features, kw, values, kw[color_name], kind in lobes.AREA_KINDS)}
+        return {"Radiance": combine_lobes(features, kw, values, kw[color_name], area)}
 
     surface_terms = shade_surface(features)
     inputs = {k: SURFACE_OUTPUTS[k] for k in surface_terms + tuple(k for k in OPTIONAL_SURFACE if k not in surface_terms)}
-    if kind in lobes.AREA_KINDS + ("point", "spot", "quad_spot"):
+    if kind != "sun":
         inputs["Position"] = GEOMETRY_INPUTS["Position"]
     inputs.update(lobes.light_geometry_sockets(kind))
     inputs[color_name] = lights.LIGHT_DATA[kind].output_sockets[color_name]
@@ -200,9 +201,16 @@ def shade_function(kind, features):
                         f"One {kind} light on the RT Lit material ({features.label()})", tables=REFERENCES)
 
 
+def shading_kind(kind):
+    """The kind whose shade function shades ``kind``: its base kind, "disk" for the lights shaded as the disk facing
+    the point (sphere lights, suns with an angle: their data functions give a disk's outputs)."""
+    base = lights.base_kind(kind)
+    return "disk" if base not in lobes.AREA_KINDS and lights.shading_form(base) == "disk" else base
+
+
 def shade_light(tables, kind, features, surface, position, light):
     """Radiance from one light: ``surface`` the "RTL Surface" outputs, ``light`` the outputs of the
     light's data function (``core.lights.LIGHT_DATA``); arrays (``tables`` with data) or Exprs."""
-    fn = shade_function(lights.base_kind(kind), features)
+    fn = shade_function(shading_kind(kind), features)
     available = dict(surface, Position=position, **light)
     return fn(tables, **_arguments(fn, available))["Radiance"]

@@ -30,9 +30,10 @@ from ..ir.interface import Socket, factor, scalar, vector
 from ..lut.lookup import REFERENCES
 from ..ltc import shading
 
+#: The shading forms over a light (core/lights.py ``SHADING_FORMS``: sphere lights and suns with an angle are disks).
 AREA_KINDS = ("quad", "disk")
-#: quad_spot: the talk's quad-to-spot fallback, shaded as a spot light (core/lights.py).
-PUNCTUAL_KINDS = ("point", "spot", "sun", "quad_spot")
+#: The kinds shaded at one direction (quad_spot: the talk's quad-to-spot fallback, shaded as a spot light).
+PUNCTUAL_KINDS = tuple(k for k, form in lights.SHADING_FORMS.items() if form == "punctual")
 
 _N = vector("Shading normal, unit, world space", "NONE", hide_value=True)
 _V = vector("Unit direction towards the viewer", "NONE", hide_value=True)
@@ -67,8 +68,7 @@ class Lobe:
     def function(self, kind):
         """The node function of this lobe for a light kind (cached; one for all punctual kinds; a kind's options
         change the light's data, not its lobes)."""
-        base = lights.base_kind(kind)
-        return _lobe_function(self.key, "punctual" if base in PUNCTUAL_KINDS else base)
+        return _lobe_function(self.key, lights.shading_form(kind))
 
 
 def punctual_cosines(n, v, l):

@@ -43,7 +43,7 @@ from .surface import SURFACE
 
 def light_parameters(kind):
     """The driver parameters of one light of ``kind`` ("Location X", ..., "Power", ...), in order."""
-    return [n for n in lights.light_data(kind).input_sockets if n != "Position"]
+    return [n for n in lights.light_data(kind).input_sockets if n not in lights.SHADING_POINT_INPUTS]
 
 
 def compose(tables, features, material, geometry, lights_in_scene, world=None):
@@ -60,8 +60,8 @@ def compose(tables, features, material, geometry, lights_in_scene, world=None):
     for kind, params in lights_in_scene:
         data_fn = lights.light_data(kind)
         args = dict(params)
-        if "Position" in data_fn.input_sockets:
-            args["Position"] = geometry["Position"]
+        shading_point = {"Position": geometry["Position"], "Normal": surface["N"]}
+        args.update({k: v for k, v in shading_point.items() if k in data_fn.input_sockets})
         light = data_fn(**args)
         parts.append(light_shading.shade_light(tables, kind, features, surface, geometry["Position"], light))
     if world is not None:

@@ -29,6 +29,8 @@ DIFFUSE_MODELS += ("oren_nayar",)
 #: sheen (Burley 2012) with its own fitted LTC under area lights; Disney sheen as the talk shades it (the CoD
 #: table at r = 0.5 under area lights).  A stored ``sheen: true`` (the old switch) is "disney_talk".
 SHEEN_MODELS = ("none", "zeltner", "disney_fitted", "disney_talk")
+#: The sheen model of Blender's Principled BSDF: what a conversion picks for a Principled material with sheen.
+PRINCIPLED_SHEEN = "zeltner"
 #: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
 #: the prefiltered radiance (the talk's approximation); core/materials/world.py.
 ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")
@@ -96,9 +98,10 @@ RT_LIT_GROUP_PREFIX = "RT Lit"
 RADIANCE_OUTPUT = "Radiance"
 EMISSION_OUTPUT = "Material Emission"
 WORLD_OUTPUT = "World Radiance"
-#: The light kinds RT Lit shades (area quad and disk, point, spot, sun, and the talk's quad-to-spot fallback:
-#: core/lights.py).  A kind may carry build-time options, "quad+cone+range" (``core.lights.split_kind``).
-LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad_spot")
+#: The light kinds RT Lit shades (area quad and disk, point, spot, sun, the talk's quad-to-spot fallback, and
+#: Blender's point and spot lights with a radius and suns with an angle: core/lights.py).  A kind may carry
+#: build-time options, "quad+cone+range" (``core.lights.split_kind``).
+LIGHT_KINDS = ("quad", "disk", "point", "spot", "sun", "quad_spot", "sphere", "spot_sphere", "sun_disk")
 
 
 def light_input(index, parameter):

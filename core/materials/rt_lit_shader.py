@@ -46,9 +46,10 @@ _VECTOR_FIELDS = {
     "Scale": ("scale", "vec3", "XYZ"),
     "Color": ("color", "vec3", "RGB"),
 }
-#: The struct of each base light kind (a kind with options gets its own: ``light_struct``) and its uniform array.
-LIGHT_STRUCTS = {"quad": "RtlAreaLight", "disk": "RtlAreaLight", "point": "RtlPointLight", "spot": "RtlSpotLight",
-                 "sun": "RtlSunLight", "quad_spot": "RtlQuadSpotLight"}
+#: The struct of each base light kind; every kind's, options included, is ``light_struct(kind)``.
+_BASE_STRUCTS = {"quad": "RtlAreaLight", "disk": "RtlAreaLight", "point": "RtlPointLight", "spot": "RtlSpotLight",
+                 "sun": "RtlSunLight", "quad_spot": "RtlQuadSpotLight", "sphere": "RtlSphereLight",
+                 "spot_sphere": "RtlSpotSphereLight", "sun_disk": "RtlSunDiskLight"}
 _WORLD_SH = 9
 
 
@@ -61,7 +62,7 @@ def light_struct(kind):
     """The struct of ``kind``'s lights: its base kind's, with the options' names for a kind with options
     ("RtlAreaLightConeRange": its fields are the base's plus the options' parameters)."""
     base, options = lights.split_kind(kind)
-    return LIGHT_STRUCTS[base] + "".join(o.capitalize() for o in options)
+    return _BASE_STRUCTS[base] + "".join(o.capitalize() for o in options)
 
 
 def light_fields(kind):
@@ -69,7 +70,7 @@ def light_fields(kind):
     (core/lights.py ``light_data``); component None for a scalar field."""
     fields, seen = [], {}
     for param in lights.light_data(kind).input_sockets:
-        if param == "Position":
+        if param in lights.SHADING_POINT_INPUTS:
             continue
         word, _, axis = param.partition(" ")
         if word in _VECTOR_FIELDS and len(axis) == 1:
@@ -350,7 +351,7 @@ def interface_markdown(shader):
     lines += [f"| `{u.name}` | `{u.type}` | {u.meaning.replace('|', '/')} |" for u in shader.uniforms]
     structs = {}
     for kind, _ in shader.light_slots:
-        structs.setdefault(LIGHT_STRUCTS[kind], kind)
+        structs.setdefault(light_struct(kind), kind)
     lines += ["", "| struct | field | type | Blender parameter (core/lights.py) |", "|---|---|---|---|"]
     for struct, kind in structs.items():
         for field, typ, parts in light_fields(kind):

@@ -95,11 +95,16 @@ class WorldEnvironment:
 
     @classmethod
     def load(cls, prefiltered_path, name):
+        """From a prefiltered EXR (``core.environment.prefilter``); exr_io's errors for an unreadable file,
+        ValueError for another table."""
         import json
 
         from ..lut import exr_io
 
         table, meta = exr_io.read_table(prefiltered_path)
+        if "roughness_levels" not in meta:
+            raise ValueError(f"{prefiltered_path} holds the table {meta['table']!r}, not prefiltered levels "
+                             "(no roughness_levels attribute)")
         levels = tuple(float(r) for r in json.loads(meta["roughness_levels"]))
         return cls(name, np.asarray(table, np.float32), levels, Path(prefiltered_path))
 

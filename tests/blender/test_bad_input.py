@@ -206,6 +206,7 @@ def test_sync_lights_names_what_is_not_shaded_and_the_capacity_of_each_feature_s
     """The Sync report says which light settings RT Lit ignores, and warns with the capacity of each material's
     switches, not a fixed number.  The capacities are set small here (the measured ones, docs/benchmarks/rt_lit.md,
     are checked by tests/core/test_cycles_capacity.py) so that a few lights exceed one set and not the other."""
+    from rt_lookdev.addon import compat
     from rt_lookdev.core.materials import cycles_capacity
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
@@ -216,16 +217,23 @@ def test_sync_lights_names_what_is_not_shaded_and_the_capacity_of_each_feature_s
     _rt_lit_object(bpy, scene, lut_dir, Features("kulla_conty", "wrapped", sheen=True, cloth=True))
     _rt_lit_object(bpy, scene, lut_dir, Features("single", "lambert"))
     key = _point_light(bpy, scene, "Key", (1.0, 2.0, 3.0))
-    key.data.shadow_soft_size = 0.1
+    key.data.shadow_soft_size = 0.1                   # shaded (a sphere light), as exposure and the angle below
     key.data.exposure = 1.0
+    key.visible_glossy = False
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.angle = 0.1
+    compat.ensure_node_tree(sun.data)
+    tree = sun.data.node_tree
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    emission = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    tree.links.new(blackbody.outputs[0], emission.inputs["Color"])
     scene.collection.objects.link(sun)
     for i in range(2):
         _point_light(bpy, scene, f"Fill {i}", (i, -2.0, 3.0))
     assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
     out = _reports(capfd)
-    assert "not shaded: Key (exposure +1, radius 0.1 m), Sun (angle 5.7 deg)" in out
+    assert ("not shaded: Key (glossy ray visibility off), Sun (node tree (Color of the Emission node not constant))"
+            in out)
     assert "(kulla-conty, wrapped, sheen, cloth) at most 3 lights" in out
     assert "(single, lambert)" not in out.split("capacity")[-1]       # 4 lights are within its 15
 

@@ -60,6 +60,8 @@ def test_controls_choose_the_kind(empty_scene, registered):
     assert materials.light_kind(obj) == "disk+cone+range"
     sun = bpy.data.objects.new("S", bpy.data.lights.new("S", "SUN"))
     sun.data.rtl_use_range = True                 # no range for the sun
+    assert materials.light_kind(sun) == "sun_disk"    # Blender's sun has an angle (0.53 deg)
+    sun.data.angle = 0.0
     assert materials.light_kind(sun) == "sun"
     # the panel's poll and the stored values the drivers read
     assert light_controls.value(data, "rtl_cone_outer") == pytest.approx(math.radians(100.0))

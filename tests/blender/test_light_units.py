@@ -285,7 +285,7 @@ def test_sun_irradiance(bpy_module):
     loc, q, s = _light(bpy, sc, "SUN", (5.0, -3.0, 2.0), _quat((1, 1, 0), 0.6), (2.0, 1.0, 1.0),
                        energy=strength, color=tuple(color))
     img, seconds = _render(bpy, sc)
-    l, e = lights.sun_light_incidence(*q, strength, color)
+    l, e = lights.sun_light_incidence(*q, s[2], strength, color)
     assert l[2] > 0.5
     expected = np.broadcast_to(e * l[2] / np.pi, img.shape)
     _judge_delta("sun", img, expected, seconds)
@@ -302,13 +302,22 @@ def _node_inputs(fn, rng):
     q = rng.normal(size=(n, 4))
     q /= np.linalg.norm(q, axis=-1, keepdims=True)
     ranges = {"Location": (-3, 3), "Scale": (0.2, 3), "Color": (0, 1), "Power": (1, 2000), "Strength": (0, 10),
-              "Size": (0.01, 4), "Spot Size": (0.1, 3.1), "Spot Blend": (0, 1), "Cone": (0.1, 3.1), "Range": (0.0, 8.0)}
+              "Size": (0.01, 4), "Spot Size": (0.1, 3.1), "Spot Blend": (0, 1), "Cone": (0.1, 3.1), "Range": (0.0, 8.0),
+              "Exposure": (-2, 2), "Radius": (0.01, 0.6), "Angle": (0.01, 1.0), "Spread": (0.3, 3.1),
+              "Excluded": (0, 1)}
     values = {}
     for name in fn.input_sockets:
         if name.startswith("Rotation "):
             v = q[:, "WXYZ".index(name[-1])]
         elif name == "Position":
             v = rng.uniform(-3, 3, (n, 3))
+        elif name == "Normal":
+            v = rng.normal(size=(n, 3))
+            v /= np.linalg.norm(v, axis=-1, keepdims=True)
+        elif name in ("Normalize", "Soft Falloff"):
+            v = (rng.uniform(0, 1, n) < 0.5).astype(np.float64)
+        elif name == "Determinant":
+            v = rng.uniform(0.2, 3, n) * rng.choice([-1.0, 1.0], n)
         else:
             key = name if name in ranges else name.rsplit(" ", 1)[0]
             v = rng.uniform(*ranges[key], n)

@@ -21,14 +21,14 @@ def lookdev(registered, empty_scene):
 
 
 def test_new_lookdev_scene_is_a_studio_setup(lookdev):
-    from rt_lookdev.addon import lookdev_scene, materials
+    from rt_lookdev.addon import light_model, lookdev_scene, materials
     from rt_lookdev.addon.common import WORLD_GROUP
 
     bpy, scene, _ = lookdev
     spheres = lookdev_scene.lookdev_spheres(scene)
     assert len(spheres) == len(lookdev_scene.ROWS) * len(lookdev_scene.ROUGHNESS)
     assert sorted(kind for _, kind in materials.scene_lights(scene)) == ["disk", "quad", "spot"]
-    assert all(not materials.ignored_light_settings(obj, kind) for obj, kind in materials.scene_lights(scene))
+    assert all(not light_model.unshaded_settings(obj, kind) for obj, kind in materials.scene_lights(scene))
     assert scene.camera is not None and scene.camera.data.type == "ORTHO"
     assert scene.render.engine == "CYCLES" and scene.cycles.max_bounces == 0
     assert scene.view_settings.view_transform == "Standard"

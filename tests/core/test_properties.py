@@ -132,7 +132,8 @@ def _aimed_light(kind, location, target, size, power):
     vals = {"Location X": location[0], "Location Y": location[1], "Location Z": location[2], "Rotation W": q[0],
             "Rotation X": q[1], "Rotation Y": q[2], "Rotation Z": q[3], "Scale X": 1.0, "Scale Y": 1.0,
             "Scale Z": 1.0, "Power": power, "Color R": 1.0, "Color G": 1.0, "Color B": 1.0, "Size": size,
-            "Size Y": size, "Spot Size": np.pi, "Spot Blend": 0.0, "Strength": 1.0}
+            "Size Y": size, "Spot Size": np.pi, "Spot Blend": 0.0, "Strength": 1.0, "Exposure": 0.0, "Normalize": 1.0,
+            "Determinant": 1.0}
     return {p: vals[p] for p in rt_lit.light_parameters(kind)}
 
 
@@ -307,7 +308,8 @@ def test_light_centred_on_the_point_is_edge_on(tables, kind):
     q = np.array([np.cos(0.3), np.sin(0.3), 0.0, 0.0])            # tilted, centred on the point
     light = {"Location X": 0.0, "Location Y": 0.0, "Location Z": 0.0, "Rotation W": q[0], "Rotation X": q[1],
              "Rotation Y": q[2], "Rotation Z": q[3], "Scale X": 1.0, "Scale Y": 1.0, "Scale Z": 1.0, "Power": 10.0,
-             "Color R": 1.0, "Color G": 1.0, "Color B": 1.0, "Size": 2e-6, "Size Y": 1e-7}
+             "Color R": 1.0, "Color G": 1.0, "Color B": 1.0, "Size": 2e-6, "Size Y": 1e-7, "Exposure": 0.0,
+                 "Normalize": 1.0, "Determinant": 1.0}
     for p, name in material.light_inputs[0].items():
         values[name] = np.asarray(light[p], np.float32)
     for dtype in (np.float32, np.float64):
