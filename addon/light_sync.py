@@ -269,13 +269,16 @@ class _SceneState:
         if any(obj.name != name for _, _, obj, name in self.lights.values()):
             return False
         moved, data = {obj.as_pointer() for obj in updates.moved()}, updates.light_data()
-        return all(self._follow_light(light) for pointer, light in self.lights.items()
-                   if pointer in moved or light[2].data.as_pointer() in data)
+        return all(self._follow_light(light, light[2].data.as_pointer() in data)
+                   for pointer, light in self.lights.items() if pointer in moved or light[2].data.as_pointer() in data)
 
-    def _follow_light(self, light):
+    def _follow_light(self, light, data_changed=True):
+        """Re-read one shaded light: its signature entry when its data changed (a transform alone changes no name,
+        kind, shape or colour: reading the entry again is a third of a moved light's update), its location and range
+        when it has one."""
         index, entry, obj, _ = light
         kind = materials.light_kind(obj)
-        if kind is None or materials.light_signature([(obj, kind)])[0] != entry:
+        if kind is None or data_changed and materials.light_signature([(obj, kind)])[0] != entry:
             return False                # renamed, another kind or shape: the signature changed
         if index in self.ranged:
             (_, loc, r), = materials.ranged_lights([(obj, kind)])
