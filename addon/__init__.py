@@ -7,14 +7,14 @@ Registration reads no file (it only checks that the preset library exists, to li
 """
 import bpy
 
-from . import (compat, convert, export_operators, light_controls, light_sync, lookdev_operators, operators, preferences,
-               preset_assets, switches, ui)
+from . import (compat, convert_ui, export_operators, light_controls, light_sync, lookdev_operators, operators,
+               preferences, preset_assets, switches, ui)
 
 classes = (
     *operators.classes,
     *export_operators.classes,
     *lookdev_operators.classes,
-    *convert.classes,
+    *convert_ui.classes,
     *preferences.classes,
     *switches.classes,
     *ui.classes,

@@ -5,8 +5,13 @@
   ``core.ir.interface.Socket`` descriptions, kept when unchanged so users of a group keep their links.
 - ``add_driver``, ``add_expression_driver``: simple-expression drivers on a socket's default value, which
   Blender evaluates without Python (so they work after a reload with auto-run off).
+- ``socket_value``, ``active_output``, ``source_node``: reading a material's tree (a socket's value as a float
+  or tuple, the active Material Output, the node feeding a socket through reroutes).
+- ``node_groups_kept_on_error``: a rebuild of the add-on's node groups as one transaction (all or nothing).
 """
 from __future__ import annotations
+
+import contextlib
 
 from ..core.ir.expr import FLOAT, VECTOR
 from ..core.materials.rt_lit_interface import NODE_GROUP_PREFIX, RT_LIT_GROUP_PREFIX
@@ -51,7 +56,9 @@ __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WO
            "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
            "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "connect_engine_outputs",
            "restore_engine_outputs", "not_a_light", "restore_emission_sampling",
-           "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "add_expression_driver"]
+           "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "add_expression_driver",
+           "socket_value", "active_output", "source_node",
+           "node_groups_kept_on_error", "before_rebuild"]
 
 SOCKET_TYPES = {"float": "NodeSocketFloat", "vector": "NodeSocketVector", "color": "NodeSocketColor",
                 "shader": "NodeSocketShader", FLOAT: "NodeSocketFloat", VECTOR: "NodeSocketVector"}
@@ -232,3 +239,177 @@ def restore_emission_sampling(material):
     if saved is not None:
         material.cycles.emission_sampling = saved
         del material[SAVED_EMISSION_SAMPLING_KEY]
+
+
+def socket_value(socket):
+    """``socket.default_value`` as a float or a tuple (a colour or a vector)."""
+    value = socket.default_value
+    try:
+        return tuple(value)
+    except TypeError:
+        return value
+
+
+def active_output(tree):
+    """The active Material Output of a material's tree (the one for all render engines first), or None."""
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    if not outputs:
+        return None
+    try:
+        node = tree.get_output_node('ALL')
+    except (AttributeError, TypeError):
+        node = None
+    if node is not None:
+        return node
+    active = [n for n in outputs if n.is_active_output]
+    for target in ('ALL', 'EEVEE', 'CYCLES'):
+        for n in active:
+            if n.target == target:
+                return n
+    return active[0] if active else outputs[0]
+
+
+def source_node(socket):
+    """The node feeding the input ``socket`` (following reroutes), or None."""
+    seen = set()
+    while socket.is_linked:
+        link = socket.links[0]
+        node = link.from_node
+        if node.bl_idname != "NodeReroute" or node.name in seen:
+            return node
+        seen.add(node.name)
+        socket = node.inputs[0]
+    return None
+
+
+@contextlib.contextmanager
+def node_groups_kept_on_error():
+    """Run the body (a rebuild of the add-on's node groups: a light sync) as one transaction: when it raises, the
+    add-on's node groups, the materials' RT Lit nodes and the file's tables are put back exactly as they were, and the
+    exception goes on.
+
+    What a sync changes is copied (``ID.copy``: nodes, links, interface with its socket identifiers, drivers) before
+    it changes: "RTL Scene Lights", the RT Lit groups (``FEATURES_KEY``) and their engine trees up front, a nested
+    group when the emitter is about to rebuild it in place (``before_rebuild``: a stale stamp).  The copies are kept
+    out of the body's way: their custom properties are held aside (no scan for RT Lit groups finds them), and their
+    Group nodes point at the other copies (Blender updates every Group node of a group whose interface changes, and
+    the lights group's changes with the lights).  On failure the copies take the originals' places (their users
+    remapped, the originals removed, names and properties given back), the materials' RT Lit nodes get their groups
+    back, and the groups and "RTL_" images the body added are removed.  On success the copies are removed, and with
+    them what only they kept in use of the groups the body removed.  Measured cost: docs/benchmarks/light_sync.md."""
+    snapshot = _GroupSnapshot()
+    _SNAPSHOTS.append(snapshot)
+    try:
+        yield
+    except BaseException:
+        _SNAPSHOTS.remove(snapshot)
+        snapshot.restore()
+        raise
+    _SNAPSHOTS.remove(snapshot)
+    snapshot.discard()
+
+
+#: The transactions under way (``node_groups_kept_on_error``).
+_SNAPSHOTS = []
+
+
+def before_rebuild(ng):
+    """Called by the emitter before it clears a group to rebuild it in place: a transaction under way keeps a copy."""
+    for snapshot in _SNAPSHOTS:
+        snapshot.keep(ng)
+
+
+def _plain(value):
+    """A custom property's value as plain Python (it outlives the ID it is read from)."""
+    return value.to_dict() if hasattr(value, "to_dict") else value.to_list() if hasattr(value, "to_list") else value
+
+
+def _removed(block):
+    try:
+        block.name
+    except ReferenceError:
+        return True
+    return False
+
+
+class _GroupSnapshot:
+    """Copies of the add-on's node groups a sync changes, the groups the materials' RT Lit nodes use, and the groups
+    and images there are (``node_groups_kept_on_error``)."""
+
+    def __init__(self):
+        import bpy
+
+        data = bpy.data
+        self.before = {ng.as_pointer() for ng in data.node_groups}
+        self.images = {image.as_pointer() for image in data.images}
+        self.groups = []               # (original, its name, its custom properties, its copy)
+        self.copies = {}               # original's pointer -> copy
+        tops = [ng for ng in data.node_groups
+                if ng.library is None and (FEATURES_KEY in ng or ng.name == SCENE_LIGHTS_GROUP)]
+        trees = {node.node_tree.as_pointer(): node.node_tree for ng in tops for node in ng.nodes
+                 if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None and node.node_tree.library is None}
+        for ng in tops + list(trees.values()):
+            self._copy(ng)
+        for *_, copy in self.groups:
+            self._point_at_copies(copy)
+        self.assigned = []
+        for material in data.materials:
+            node = material.node_tree.nodes.get(RT_LIT_NODE_NAME) if material.node_tree is not None else None
+            if node is not None and node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
+                self.assigned.append((material, self.copies.get(node.node_tree.as_pointer(), node.node_tree)))
+
+    def _copy(self, ng):
+        if ng.as_pointer() in self.copies:
+            return None
+        copy = ng.copy()
+        properties = {key: _plain(ng[key]) for key in ng.keys()}
+        for key in properties:
+            del copy[key]
+        self.groups.append((ng, ng.name, properties, copy))
+        self.copies[ng.as_pointer()] = copy
+        return copy
+
+    def _point_at_copies(self, tree):
+        for node in tree.nodes:
+            if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
+                copy = self.copies.get(node.node_tree.as_pointer())
+                if copy is not None and copy != tree:
+                    node.node_tree = copy
+
+    def keep(self, ng):
+        """Copy ``ng``, about to be rebuilt in place, if it existed before the body and is not copied yet."""
+        if ng.as_pointer() in self.before and self._copy(ng) is not None:
+            for *_, copy in self.groups:
+                self._point_at_copies(copy)
+
+    def restore(self):
+        import bpy
+
+        data = bpy.data
+        for material, group in self.assigned:
+            node = material.node_tree.nodes.get(RT_LIT_NODE_NAME)
+            if node is not None and node.node_tree != group:
+                node.node_tree = group
+        kept = self.before | {copy.as_pointer() for *_, copy in self.groups}
+        removed = [ng for ng in data.node_groups if ng.as_pointer() not in kept]
+        for ng, _, _, copy in self.groups:
+            if not _removed(ng):
+                ng.user_remap(copy)
+                removed.append(ng)
+        removed += [image for image in data.images
+                    if image.as_pointer() not in self.images and image.name.startswith(IMAGE_PREFIX)]
+        data.batch_remove(removed)
+        for _, name, properties, copy in self.groups:
+            copy.name = name
+            for key, value in properties.items():
+                copy[key] = value
+
+    def discard(self):
+        import bpy
+
+        data = bpy.data
+        # the body removed these (culled groups no material uses); what they used, only their copies use now
+        used = {node.node_tree.as_pointer() for ng, _, _, copy in self.groups if _removed(ng)
+                for node in copy.nodes if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None}
+        data.batch_remove([copy for *_, copy in self.groups])
+        data.batch_remove([ng for ng in data.node_groups if ng.as_pointer() in used and ng.users == 0])

@@ -1,4 +1,7 @@
-"""Convert a Principled BSDF material into an RT Lit lookdev material and back.
+"""Convert a Principled BSDF material into an RT Lit lookdev material and back: the node-tree edits (the
+RT Lit node built, the kept Principled restored, values, links and drivers transferred).  Which inputs
+correspond and how a value crosses is ``core/materials/principled_mapping.py``; the operators and the
+switches' UI are ``convert_ui.py``.
 
 An RT Lit material's surface is ``RT Lit group node (Shader output) -> Material Output``: the
 group computes the outgoing radiance itself and emits it (one Emission closure per light inside
@@ -21,32 +24,21 @@ The material remembers its switches in ``material[common.FEATURES_KEY]`` (a dict
 a conversion without explicit features reuses them.  Converting an RT Lit material again is
 idempotent: no nodes are added, the group is swapped only when the features ask for another one.
 
-The pure functions raise ``ConversionError`` (before changing anything) when a material cannot
-be converted; the operators turn that into reports.
+The functions here raise ``ConversionError`` (before changing anything) when a material cannot
+be converted; the operators (``convert_ui``) turn that into reports.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty
 
-from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, PRINCIPLED_SHEEN, RT_LIT_INPUTS, SHEEN_MODELS,
-                                               SPECULAR_MODELS, Features)
-from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, connect_engine_outputs, not_a_light, restore_emission_sampling,
-                     restore_engine_outputs)
-
-#: Principled BSDF input -> RT Lit input (same names).  "Normal" is link-only.
-MAPPED_INPUTS = (
-    "Base Color", "Metallic", "Roughness", "IOR", "Specular IOR Level", "Specular Tint",
-    "Sheen Weight", "Sheen Roughness", "Sheen Tint", "Emission Color", "Emission Strength", "Normal",
-)
-#: Principled's Diffuse Roughness (Blender 4.3+) drives RT Lit's "oren_nayar" diffuse (core/rough_diffuse.py).
-MAPPED_INPUTS += ("Diffuse Roughness",)
-#: Inputs whose value is never copied (only their link): the value is hidden and unused.
-LINK_ONLY_INPUTS = ("Normal",)
-#: RT Lit inputs with no Principled counterpart; their values are remembered on the material.
-RT_LIT_ONLY_INPUTS = tuple(name for name in RT_LIT_INPUTS if name not in MAPPED_INPUTS)
+from ..core.materials.principled_mapping import (LINK_ONLY_INPUTS, MAPPED_INPUTS, RT_LIT_ONLY_INPUTS, converted_value,
+                                                values_equal)
+from ..core.materials.rt_lit_interface import PRINCIPLED_SHEEN, Features
+from .common import (FEATURES_KEY, RT_LIT_NODE_NAME, active_output, connect_engine_outputs, not_a_light,
+                     restore_emission_sampling, restore_engine_outputs, socket_value, source_node)
+from .materials import ensure_rt_lit_group
 
 EMISSION_NODE_NAME = "RT Lit Emission"
 FRAME_NODE_NAME = "RT Lit Kept Principled"
@@ -60,38 +52,6 @@ ROLE_PROP = "rtl_role"                  # "rt_lit" | "emission" | "frame" | "kep
 SAVED_LOCATION_PROP = "rtl_location"    # kept Principled: where it stood (absolute)
 SAVED_PARENT_PROP = "rtl_parent"        # kept Principled: its frame before ("" = none)
 SAVED_HIDE_PROP = "rtl_hide"            # kept Principled: was it collapsed
-
-FLOAT_TOLERANCE = 1e-6
-
-SPECULAR_LABELS = {
-    "single": ("Single Scattering", "GGX single scattering only (loses energy at high roughness)"),
-    "turquin": ("Turquin", "Turquin 2019 energy compensation (scales the GGX lobe by 1 / E)"),
-    "fdez_aguera": ("Fdez-Agüera", "Fdez-Agüera 2019 multiple-scattering approximation"),
-    "kulla_conty": ("Kulla-Conty", "Kulla & Conty 2017 multiple-scattering lobe"),
-    "none": ("None", "No specular lobe: diffuse (and cloth, sheen) only"),
-}
-DIFFUSE_LABELS = {
-    "lambert": ("Lambert", "Lambertian diffuse"),
-    "cod": ("CoD WWII", "Call of Duty WWII multiscattering diffuse (Chan 2018)"),
-    "wrapped": ("Wrapped", "Energy-conserving wrapped diffuse (uses the Wrap input)"),
-    "cod_wrapped": ("CoD WWII Wrapped", "Multiscattering diffuse with wrapped lighting, the talk's closing table "
-                                        "(uses the Wrap input)"),
-    "oren_nayar": ("Oren-Nayar (Cycles)", "Rough diffuse as Cycles shades Principled's Diffuse Roughness: Fujii's "
-                   "Oren-Nayar with EON's multiple scattering (uses the Diffuse Roughness input)"),
-}
-
-SPECULAR_ITEMS = tuple((m, *SPECULAR_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SPECULAR_MODELS)
-ENVIRONMENT_MS_ITEMS = (('irradiance', "Irradiance", "Fdez-Aguera 2019: FssEss x radiance + FmsEms x irradiance"),
-                        ('radiance', "Radiance", "The talk: (FssEss + FmsEms) x prefiltered radiance"))
-DIFFUSE_ITEMS = tuple((m, *DIFFUSE_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in DIFFUSE_MODELS)
-SHEEN_LABELS = {
-    "none": ("None", "No sheen lobe"),
-    "zeltner": ("Zeltner (Principled)", "Zeltner, Burley & Chiang 2022: the sheen of Blender's Principled BSDF, "
-                "layered over the lobes below as Principled does; uses Sheen Roughness"),
-    "disney_fitted": ("Disney (fitted LTC)", "Disney sheen (1 - l.h)^5 with its own fitted LTC under area lights"),
-    "disney_talk": ("Disney (talk)", "Disney sheen as the talk shades it: the CoD table at r = 0.5 under area lights"),
-}
-SHEEN_ITEMS = tuple((m, *SHEEN_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SHEEN_MODELS)
 
 
 class ConversionError(ValueError):
@@ -125,38 +85,6 @@ def _nodes_with_role(tree, role):
     return [n for n in tree.nodes if _role(n) == role]
 
 
-def _active_output(tree):
-    """The active Material Output (the one for all render engines first), or None."""
-    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
-    if not outputs:
-        return None
-    try:
-        node = tree.get_output_node('ALL')
-    except (AttributeError, TypeError):
-        node = None
-    if node is not None:
-        return node
-    active = [n for n in outputs if n.is_active_output]
-    for target in ('ALL', 'EEVEE', 'CYCLES'):
-        for n in active:
-            if n.target == target:
-                return n
-    return active[0] if active else outputs[0]
-
-
-def _source_node(socket):
-    """The node feeding ``socket`` (following reroutes), or None."""
-    seen = set()
-    while socket.is_linked:
-        link = socket.links[0]
-        node = link.from_node
-        if node.bl_idname != "NodeReroute" or node.name in seen:
-            return node
-        seen.add(node.name)
-        socket = node.inputs[0]
-    return None
-
-
 def _is_rt_lit_node(node):
     return node is not None and node.bl_idname == "ShaderNodeGroup" and (
         _role(node) == "rt_lit" or node.name == RT_LIT_NODE_NAME)
@@ -164,9 +92,9 @@ def _is_rt_lit_node(node):
 
 def _rt_lit_feeding(output):
     """The RT Lit node feeding the output's Surface (directly or through an Emission), or None."""
-    node = _source_node(output.inputs["Surface"])
+    node = source_node(output.inputs["Surface"])
     if node is not None and node.bl_idname == "ShaderNodeEmission":
-        node = _source_node(node.inputs["Color"])
+        node = source_node(node.inputs["Color"])
     return node if _is_rt_lit_node(node) else None
 
 
@@ -176,7 +104,7 @@ def find_rt_lit_node(material):
     tree = material.node_tree
     if tree is None:
         return None
-    output = _active_output(tree)
+    output = active_output(tree)
     node = _rt_lit_feeding(output) if output is not None else None
     if node is not None:
         return node
@@ -191,27 +119,11 @@ def is_rt_lit_material(material):
     return material is not None and find_rt_lit_node(material) is not None
 
 
-def _value(socket):
-    value = socket.default_value
-    try:
-        return tuple(value)
-    except TypeError:
-        return value
-
-
 def _copy_value(src, dst):
     """Copy ``src``'s default value to ``dst`` (float, colour or vector; sizes adapted)."""
     if not hasattr(src, "default_value") or not hasattr(dst, "default_value"):
         return
-    value = _value(src)
-    target = _value(dst)
-    if isinstance(target, tuple):
-        if not isinstance(value, tuple):
-            value = (value,) * len(target)
-        value = tuple(value[:len(target)]) + tuple(target[len(value):])
-    elif isinstance(value, tuple):
-        value = sum(value[:3]) / min(len(value), 3)
-    dst.default_value = value
+    dst.default_value = converted_value(socket_value(src), socket_value(dst))
 
 
 def _relink(tree, src_input, dst_input):
@@ -251,7 +163,7 @@ def _move_drivers(tree, src, dst):
     """Move the drivers of ``src``'s value onto ``dst``'s (a driven Principled input stays driven in RT Lit
     and back); a driver on a component ``dst`` lacks is dropped."""
     for fc in _socket_drivers(tree, src):
-        size = len(_value(dst)) if isinstance(_value(dst), tuple) else 0
+        size = len(socket_value(dst)) if isinstance(socket_value(dst), tuple) else 0
         if size and fc.array_index >= size:
             continue
         new = dst.driver_add("default_value", fc.array_index) if size else dst.driver_add("default_value")
@@ -271,15 +183,6 @@ def _transfer(tree, src_node, dst_node, names):
         _move_drivers(tree, src, dst)
 
 
-def _equal(a, b):
-    if isinstance(a, tuple) or isinstance(b, tuple):
-        a, b = tuple(a) if isinstance(a, tuple) else (a,), tuple(b) if isinstance(b, tuple) else (b,)
-        return len(a) == len(b) and all(abs(x - y) <= FLOAT_TOLERANCE for x, y in zip(a, b))
-    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
-        return abs(a - b) <= FLOAT_TOLERANCE
-    return a == b
-
-
 _principled_defaults: dict[str, object] = {}
 
 
@@ -291,7 +194,7 @@ def principled_defaults():
             node = group.nodes.new("ShaderNodeBsdfPrincipled")
             for socket in node.inputs:
                 if hasattr(socket, "default_value"):
-                    _principled_defaults[socket.identifier] = _value(socket)
+                    _principled_defaults[socket.identifier] = socket_value(socket)
         finally:
             bpy.data.node_groups.remove(group)
     return _principled_defaults
@@ -308,21 +211,9 @@ def ignored_principled_inputs(node):
         if socket.is_linked:
             ignored.append(socket.name)
         elif hasattr(socket, "default_value") and socket.identifier in defaults \
-                and not socket.hide_value and not _equal(_value(socket), defaults[socket.identifier]):
+                and not socket.hide_value and not values_equal(socket_value(socket), defaults[socket.identifier]):
             ignored.append(socket.name)
     return tuple(ignored)
-
-
-def draw_switches(layout, owner):
-    """The RT Lit switches of ``owner`` (the Convert dialog, or a material's ``rtl_switches``): specular,
-    the world form (active for Fdez-Aguera), diffuse, sheen and cloth."""
-    layout.prop(owner, "specular")
-    sub = layout.row()
-    sub.active = owner.specular == 'fdez_aguera'
-    sub.prop(owner, "environment_ms")
-    layout.prop(owner, "diffuse")
-    layout.prop(owner, "sheen")
-    layout.prop(owner, "cloth")
 
 
 def principled_uses_sheen(material):
@@ -342,8 +233,8 @@ def _principled_input_used(material, name):
     (False without such a node or input)."""
     if material is None or material.node_tree is None:
         return False
-    output = _active_output(material.node_tree)
-    node = _source_node(output.inputs["Surface"]) if output is not None else None
+    output = active_output(material.node_tree)
+    node = source_node(output.inputs["Surface"]) if output is not None else None
     if node is None or node.bl_idname != "ShaderNodeBsdfPrincipled" or node.inputs.get(name) is None:
         return False
     socket = node.inputs[name]
@@ -383,7 +274,7 @@ def _check_editable(material):
                               "(Object > Relations > Make Local) or convert it in its own file")
     if material.node_tree is None:
         raise ConversionError(f"Material '{material.name}' has no node tree (it does not use nodes)")
-    output = _active_output(material.node_tree)
+    output = active_output(material.node_tree)
     if output is None:
         raise ConversionError(f"Material '{material.name}' has no Material Output node")
     return material.node_tree, output
@@ -397,7 +288,7 @@ def _swap_group(tree, rt, group):
     """Point ``rt`` at ``group``, keeping its input values and links (by name)."""
     if rt.node_tree == group:
         return False
-    values = {s.name: _value(s) for s in rt.inputs if hasattr(s, "default_value")}
+    values = {s.name: socket_value(s) for s in rt.inputs if hasattr(s, "default_value")}
     links = {s.name: [(l.from_socket, l.is_muted) for l in s.links] for s in rt.inputs}
     rt.node_tree = group
     for socket in rt.inputs:
@@ -471,7 +362,7 @@ def principled_to_rt_lit(material, group_factory, features=None):
         rt.label = f"RT Lit ({features.label()})"
         return ConversionResult(material.name, "updated" if changed else "unchanged", features=features)
 
-    principled = _source_node(output.inputs["Surface"])
+    principled = source_node(output.inputs["Surface"])
     if principled is None or principled.bl_idname != "ShaderNodeBsdfPrincipled":
         found = "nothing" if principled is None else f"'{principled.name}' ({principled.bl_label})"
         raise ConversionError(
@@ -562,7 +453,8 @@ def principled_to_rt_lit(material, group_factory, features=None):
 # RT Lit -> Principled
 
 
-def _kept_principled(tree):
+def kept_principled(tree):
+    """The Principled BSDF a conversion kept in ``tree`` (tagged, or in the kept-frame), or None."""
     kept = [n for n in _nodes_with_role(tree, "kept_principled") if n.bl_idname == "ShaderNodeBsdfPrincipled"]
     if kept:
         return kept[0]
@@ -592,7 +484,7 @@ def rt_lit_to_principled(material):
         raise ConversionError(f"Material '{material.name}': the RT Lit node '{rt.name}' has no node group")
 
     result = ConversionResult(material.name, "converted", features=stored_features(material))
-    principled = _kept_principled(tree)
+    principled = kept_principled(tree)
     if principled is None:
         principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
         principled.location = _absolute_location(rt)
@@ -609,7 +501,7 @@ def rt_lit_to_principled(material):
         if socket is None:
             continue
         if hasattr(socket, "default_value"):
-            remembered[name] = _value(socket)
+            remembered[name] = socket_value(socket)
         if socket.is_linked:
             dropped.append(name)
     if remembered:
@@ -626,184 +518,9 @@ def rt_lit_to_principled(material):
 
 
 # --------------------------------------------------------------------------------------------
-# Operators
-
-TARGET_ITEMS = (
-    ('ACTIVE', "Active Material", "Convert the active material"),
-    ('SELECTED', "Selected Objects", "Convert every material of the selected objects"),
-)
+# The add-on's RT Lit groups
 
 
 def default_group_factory(lut_dir=None):
-    """The add-on's RT Lit group factory, reading the LUTs of ``lut_dir`` (imported lazily:
-    ``.materials`` is optional here)."""
-    from .materials import ensure_rt_lit_group
-
+    """The add-on's RT Lit group factory (``materials.ensure_rt_lit_group``), reading the LUTs of ``lut_dir``."""
     return lambda features: ensure_rt_lit_group(features, lut_dir=lut_dir)
-
-
-def _active_material(context):
-    material = getattr(context, "material", None)
-    if material is None:
-        obj = getattr(context, "object", None) or getattr(context, "active_object", None)
-        material = obj.active_material if obj is not None else None
-    return material
-
-
-def _selected_materials(context):
-    materials, seen = [], set()
-    for obj in getattr(context, "selected_objects", None) or ():
-        for slot in obj.material_slots:
-            mat = slot.material
-            if mat is not None and mat.name_full not in seen:
-                seen.add(mat.name_full)
-                materials.append(mat)
-    return materials
-
-
-def target_materials(context, target):
-    if target == 'SELECTED':
-        return _selected_materials(context)
-    material = _active_material(context)
-    return [material] if material is not None else []
-
-
-def _report_results(op, done, failures, verb):
-    """One report per kind; returns the operator's result set."""
-    warnings = [w for r in done for w in r.warnings]
-    for message in failures + warnings:
-        print(f"RT Lookdev: {message}")
-    if not done:
-        op.report({'ERROR'}, "; ".join(failures) if failures else "No material to convert")
-        return {'CANCELLED'}
-    names = ", ".join(f"'{r.material}'" for r in done)
-    summary = f"{verb} {len(done)} material{'s' if len(done) != 1 else ''} ({names})"
-    if failures or warnings:
-        op.report({'WARNING'}, "; ".join([summary] + failures + warnings))
-    else:
-        op.report({'INFO'}, summary)
-    return {'FINISHED'}
-
-
-class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
-    """Convert Principled BSDF materials to RT Lit lookdev materials (the Principled BSDF is kept,
-    collapsed, for converting back)"""
-
-    bl_idname = "rtl.convert_to_rt_lit"
-    bl_label = "Convert to RT Lit"
-    bl_options = {'REGISTER', 'UNDO'}
-
-    target: EnumProperty(name="Materials", items=TARGET_ITEMS, default='ACTIVE')
-    specular: EnumProperty(
-        name="Specular",
-        description="Specular multiple-scattering model the RT Lit group is built with",
-        items=SPECULAR_ITEMS,
-        default=Features().specular,
-    )
-    diffuse: EnumProperty(
-        name="Diffuse",
-        description="Diffuse model the RT Lit group is built with",
-        items=DIFFUSE_ITEMS,
-        default=Features().diffuse,
-    )
-    sheen: EnumProperty(name="Sheen", description="Sheen lobe the RT Lit group is built with", items=SHEEN_ITEMS,
-                        default=Features().sheen)
-    cloth: BoolProperty(name="Cloth", description="Build the group with the Ashikhmin cloth lobe",
-                        default=Features().cloth)
-    environment_ms: EnumProperty(
-        name="World Multiscattering",
-        description="Fdez-Aguera multiple scattering under the world: lit by the irradiance (the paper) or "
-                    "by the prefiltered radiance (the talk's approximation)",
-        items=ENVIRONMENT_MS_ITEMS,
-        default=Features().environment_ms,
-    )
-
-    @classmethod
-    def poll(cls, context):
-        if _active_material(context) is None and not _selected_materials(context):
-            cls.poll_message_set("No active material, and no selected object has a material")
-            return False
-        return True
-
-    def features(self):
-        return Features(specular=self.specular, diffuse=self.diffuse, sheen=self.sheen, cloth=self.cloth,
-                        environment_ms=self.environment_ms)
-
-    def invoke(self, context, event):
-        material = _active_material(context)
-        stored = stored_features(material)
-        if stored is not None:
-            self.specular, self.diffuse = stored.specular, stored.diffuse
-            self.sheen, self.cloth = stored.sheen, stored.cloth
-            self.environment_ms = stored.environment_ms
-        else:
-            if self.sheen == "none" and principled_uses_sheen(material):
-                self.sheen = PRINCIPLED_SHEEN
-            if principled_uses_diffuse_roughness(material):
-                self.diffuse = "oren_nayar"
-        return context.window_manager.invoke_props_dialog(self)
-
-    def draw(self, context):
-        self.layout.prop(self, "target")
-        draw_switches(self.layout, self)
-
-    def execute(self, context):
-        materials = target_materials(context, self.target)
-        if not materials:
-            self.report({'ERROR'}, "No material to convert" + (
-                " (no selected object has a material)" if self.target == 'SELECTED' else ""))
-            return {'CANCELLED'}
-        try:
-            from . import preferences
-
-            factory = default_group_factory(preferences.lut_directory(context))
-        except ImportError as ex:
-            self.report({'ERROR'}, f"The RT Lit node group is not available: {ex}")
-            return {'CANCELLED'}
-        features = self.features()
-        done, failures = [], []
-        for material in materials:
-            try:
-                done.append(principled_to_rt_lit(material, factory, features))
-            except ConversionError as ex:
-                failures.append(str(ex))
-            except Exception as ex:  # the group factory failed: nothing was changed
-                failures.append(f"Material '{material.name}': could not build the RT Lit group "
-                                f"({type(ex).__name__}: {ex})")
-        return _report_results(self, done, failures, f"Converted to RT Lit ({features.label()})")
-
-
-class RTL_OT_convert_to_principled(bpy.types.Operator):
-    """Convert RT Lit materials back to Principled BSDF, keeping the values and links edited in RT Lit"""
-
-    bl_idname = "rtl.convert_to_principled"
-    bl_label = "Convert to Principled"
-    bl_options = {'REGISTER', 'UNDO'}
-
-    target: EnumProperty(name="Materials", items=TARGET_ITEMS, default='ACTIVE')
-
-    @classmethod
-    def poll(cls, context):
-        candidates = [_active_material(context)] + _selected_materials(context)
-        if not any(is_rt_lit_material(m) for m in candidates if m is not None):
-            cls.poll_message_set("Neither the active material nor a selected object's material is an RT Lit material")
-            return False
-        return True
-
-    def execute(self, context):
-        materials = [m for m in target_materials(context, self.target)]
-        if not materials:
-            self.report({'ERROR'}, "No material to convert")
-            return {'CANCELLED'}
-        if self.target == 'SELECTED':  # non-RT Lit materials among the selection are not errors
-            materials = [m for m in materials if is_rt_lit_material(m)] or materials
-        done, failures = [], []
-        for material in materials:
-            try:
-                done.append(rt_lit_to_principled(material))
-            except ConversionError as ex:
-                failures.append(str(ex))
-        return _report_results(self, done, failures, "Converted to Principled")
-
-
-classes = (RTL_OT_convert_to_rt_lit, RTL_OT_convert_to_principled)

@@ -120,8 +120,11 @@ class RTL_PT_light(bpy.types.Panel):
         return getattr(context, "light", None) is not None
 
     def draw(self, context):
+        from .ui import draw_light_sync_failure
+
         layout = self.layout
         data = context.light
+        draw_light_sync_failure(layout, context.scene)      # a light added or changed may be what failed to sync
         if data.type == 'SUN':
             layout.label(text="RT Lit has no controls for sun lights", icon='INFO')
             return

@@ -6,7 +6,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from . import lookdev_scene, preferences
-from .convert import DIFFUSE_ITEMS, SPECULAR_ITEMS
+from .convert_ui import DIFFUSE_ITEMS, SPECULAR_ITEMS
 from .operators import lut_directory_exists
 from ..core.materials.rt_lit_interface import Features
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 import bpy
-import mathutils
+import numpy as np
 
 from ..core import lights as core_lights
 from ..core.ir.expr import FLOAT, table_filter
@@ -128,15 +128,26 @@ def light_signature(records):
 def lights_out_of_sync(scene):
     """Whether ``scene``'s shaded lights differ from the ones the RT Lit groups were last synced for (False
     when the file has no RT Lit group: nothing to keep in sync)."""
-    if not any(ng.name.startswith(RT_LIT_GROUP_PREFIX) and FEATURES_KEY in ng for ng in bpy.data.node_groups):
+    if not has_rt_lit_groups():
         return False
+    records = scene_lights(scene)
+    return differs_from_sync(light_signature(records), lambda: material_reach(scene, records))
+
+
+def has_rt_lit_groups():
+    """Whether the file has an RT Lit group (then its lights are kept in sync)."""
+    return any(ng.name.startswith(RT_LIT_GROUP_PREFIX) and FEATURES_KEY in ng for ng in bpy.data.node_groups)
+
+
+def differs_from_sync(signature, reach):
+    """Whether the RT Lit groups were last synced for another light signature (``light_signature``) or, with
+    ``reach()`` called only when the signatures agree, for another reach (``material_reach``)."""
     ng = bpy.data.node_groups.get(SCENE_LIGHTS_GROUP)
     synced = list(ng.get(LIGHTS_SIGNATURE_KEY, [])) if ng is not None else []
-    records = scene_lights(scene)
-    if light_signature(records) != synced:
+    if signature != synced:
         return True
     # a light with a range or an object that moved can change which lights reach a material (``cull_lights``)
-    return ng is not None and _reach_record(material_reach(scene, records)) != ng.get(REACH_KEY, _reach_record({}))
+    return ng is not None and _reach_record(reach()) != ng.get(REACH_KEY, _reach_record({}))
 
 
 def synced_light_kinds():
@@ -348,11 +359,11 @@ def rebuild_rt_lit_groups(scene, lut_dir=None):
 # A light with a range (core/lights.py, option "range") gives exactly 0 beyond it (Karis 2013's window is 0 for
 # d >= r).  A material whose objects all lie beyond a light's range gets an RT Lit group without that light:
 # the same values, fewer nodes.  "Beyond" is tested against a sphere around each object (conservative: a light
-# may be kept that a box would cull), so the check stays cheap enough for every depsgraph update (1.4 ms on a
-# 100-object scene with 10 ranged lights, docs/benchmarks/light_sync.md).  Which lights reach which material is
-# re-checked when lights or objects change (``lights_out_of_sync``; the automatic light sync re-culls).
+# may be kept that a box would cull).  Which lights reach which material is re-checked when lights or objects
+# change (``lights_out_of_sync``); the automatic light sync keeps each object's sphere between depsgraph updates and
+# re-computes only what an update names (addon/light_sync.py; docs/benchmarks/light_sync.md).
 
-def _rendered_objects(scene):
+def rendered_objects(scene):
     """The objects a render of ``scene`` includes (as ``is_rendered``, in one pass over the collections)."""
     names = set()
     for layer in scene.view_layers:
@@ -370,47 +381,134 @@ def _rendered_objects(scene):
     return out
 
 
+def render_layout(scene):
+    """What decides which collections a render of ``scene`` includes: each view layer's use and included collections,
+    and the collections disabled in renders.  While it is unchanged, only a change of an object itself (its
+    ``hide_render``, its collections) changes the objects a render includes."""
+    layers = tuple((layer.name, layer.use, frozenset(_layer_collections(scene, layer)) if layer.use else None)
+                   for layer in scene.view_layers)
+    return layers, frozenset(c.name for c in bpy.data.collections if c.hide_render)
+
+
 _GEOMETRY = {"MESH", "CURVE", "SURFACE", "META", "FONT"}
 
 
-def _material_spheres(scene):
-    """{material name: [(world centre, radius)]}: a sphere around each rendered object using the material (its
-    bounding box's centre and half-diagonal, times its largest scale: conservative, and cheap for every update)."""
-    spheres = {}
-    for obj in _rendered_objects(scene):
-        if obj.type not in _GEOMETRY:
-            continue
-        names = {slot.material.name for slot in obj.material_slots if slot.material is not None}
-        if not names:
-            continue
-        lo, hi = obj.bound_box[0], obj.bound_box[6]
-        m = obj.matrix_world
-        centre = m @ mathutils.Vector(((lo[0] + hi[0]) * 0.5, (lo[1] + hi[1]) * 0.5, (lo[2] + hi[2]) * 0.5))
-        half = mathutils.Vector(((hi[0] - lo[0]) * 0.5, (hi[1] - lo[1]) * 0.5, (hi[2] - lo[2]) * 0.5)).length
-        radius = half * max(abs(x) for x in m.to_scale())
-        for name in names:
-            spheres.setdefault(name, []).append((tuple(centre), radius))
-    return spheres
+def _material_pointers(obj):
+    """The pointers of the materials an object of a geometry type uses (sorted), () for none or another type."""
+    if obj.type not in _GEOMETRY:
+        return ()
+    return tuple(sorted({slot.material.as_pointer() for slot in obj.material_slots if slot.material is not None}))
+
+
+def _spheres(matrices, boxes):
+    """Centres (n, 3) and radii (n,) of the spheres around objects from their world matrices (n, 4, 4; rows first) and
+    object-space bounding boxes (n, 8, 3): the box's centre and half-diagonal, the radius times the largest scale (of
+    the matrix's columns).  Element by element, so one object gives the same sphere alone as among many."""
+    m, b = matrices.astype(np.float64), boxes.astype(np.float64)
+    mid, half = (b[:, 0] + b[:, 6]) * 0.5, (b[:, 6] - b[:, 0]) * 0.5
+    centres = m[:, :3, 0] * mid[:, :1] + m[:, :3, 1] * mid[:, 1:2] + m[:, :3, 2] * mid[:, 2:] + m[:, :3, 3]
+    length = np.sqrt(half[:, 0] ** 2 + half[:, 1] ** 2 + half[:, 2] ** 2)
+    scale = np.sqrt(m[:, 0, :3] ** 2 + m[:, 1, :3] ** 2 + m[:, 2, :3] ** 2).max(axis=1)
+    return centres, length * scale
+
+
+def reach_row(obj):
+    """(material pointers, sphere centre, sphere radius) of an object for the reach check: a sphere around it (its
+    bounding box's centre and half-diagonal, times its largest scale: conservative, and cheap for every update);
+    None for an object without geometry or materials."""
+    used = _material_pointers(obj)
+    if not used:
+        return None
+    centres, radii = _spheres(np.array(obj.matrix_world, np.float32)[None], np.array(obj.bound_box, np.float32)[None])
+    return used, tuple(centres[0]), float(radii[0])
+
+
+def reach_rows(scene, objects):
+    """{object pointer: ``reach_row``} of the ``objects`` of ``scene`` (a set) that have one, all at once: the world
+    matrices and bounding boxes of the scene's objects read in one call each (``foreach_get``)."""
+    found, picked = [], []
+    for i, obj in enumerate(scene.objects):
+        used = _material_pointers(obj) if obj in objects else ()
+        if used:
+            found.append((obj.as_pointer(), used))
+            picked.append(i)
+    if not picked:
+        return {}
+    n = len(scene.objects)
+    matrices, boxes = np.empty(n * 16, np.float32), np.empty(n * 24, np.float32)
+    scene.objects.foreach_get("matrix_world", matrices)           # columns first
+    scene.objects.foreach_get("bound_box", boxes)
+    centres, radii = _spheres(matrices.reshape(n, 4, 4).transpose(0, 2, 1)[picked], boxes.reshape(n, 8, 3)[picked])
+    return {pointer: (used, tuple(c), float(r)) for (pointer, used), c, r in zip(found, centres, radii)}
+
+
+def material_spheres(rows, places=None):
+    """The spheres of ``rows`` ({object: ``reach_row``}) by material: (material pointers, starts, centres (n, 3), radii
+    (n,)), material k's rows from starts[k] to starts[k + 1]; ``places``, when given, is filled with {object: [its row
+    indices]}."""
+    found = {}
+    for obj, (used, centre, radius) in rows.items():
+        for pointer in used:
+            found.setdefault(pointer, []).append((obj, centre, radius))
+    starts, centres, radii = [0], [], []
+    for spheres in found.values():
+        for obj, centre, radius in spheres:
+            if places is not None:
+                places.setdefault(obj, []).append(len(radii))
+            centres.append(centre)
+            radii.append(radius)
+        starts.append(len(radii))
+    return list(found), np.array(starts), np.array(centres, np.float64).reshape(-1, 3), np.array(radii, np.float64)
+
+
+def ranged_lights(records):
+    """[(index, location, range)] of the lights with a range among ``records`` ([(object, kind)])."""
+    return [(i, tuple(obj.matrix_world.translation), float(light_controls.value(obj.data, "rtl_range")))
+            for i, (obj, kind) in enumerate(records) if "range" in core_lights.split_kind(kind)[1]]
+
+
+def out_of_range(ranged, spheres):
+    """{material pointer: the indices of the lights of ``ranged`` ([(index, location, range)]) that reach none of its
+    spheres} (``spheres``: ``material_spheres``): every sphere of the material lies at or beyond the light's range."""
+    materials, starts, centres, radii = spheres
+    if not ranged or not materials:
+        return {m: frozenset() for m in materials}
+    locations = np.array([loc for _, loc, _ in ranged], np.float64)
+    ranges = np.array([r for _, _, r in ranged], np.float64)
+    squared = np.zeros((len(ranged), len(radii)))          # (lights, spheres): the spheres along numpy's fast axis
+    for axis in range(3):
+        offset = locations[:, axis:axis + 1] - centres[:, axis]
+        offset *= offset
+        squared += offset
+    gaps = np.sqrt(squared) - radii
+    reached = np.logical_or.reduceat(~(gaps >= ranges[:, None]), starts[:-1], axis=1)    # (lights, materials)
+    return {m: frozenset(i for (i, _, _), hit in zip(ranged, column) if not hit)
+            for m, column in zip(materials, reached.T)}
+
+
+def reach_of_materials(beyond, count):
+    """What ``material_reach`` returns, from ``beyond`` ({material pointer: indices of the lights that reach none of
+    its objects}) and the number of scene lights: {material name: indices of the lights that can reach it} for the
+    RT Lit materials some light cannot reach."""
+    if not any(beyond.values()):
+        return {}
+    materials = {m.as_pointer(): m for m in bpy.data.materials}
+    out = {}
+    for pointer, far in beyond.items():
+        material = materials.get(pointer)
+        if far and material is not None and FEATURES_KEY in material.keys():
+            out[material.name] = [i for i in range(count) if i not in far]
+    return out
 
 
 def material_reach(scene, records):
     """{material name: indices of the lights that can reach its objects} for the RT Lit materials some light with
     a range cannot reach; {} when every light reaches every material."""
-    ranged = []
-    for i, (obj, kind) in enumerate(records):
-        if "range" in core_lights.split_kind(kind)[1]:
-            ranged.append((i, tuple(obj.matrix_world.translation), float(light_controls.value(obj.data, "rtl_range"))))
+    ranged = ranged_lights(records)
     if not ranged:
         return {}
-    out = {}
-    for name, spheres in _material_spheres(scene).items():
-        material = bpy.data.materials.get(name)
-        if material is None or FEATURES_KEY not in material.keys():
-            continue
-        out_of_range = {i for i, loc, r in ranged if all(math.dist(loc, c) - radius >= r for c, radius in spheres)}
-        if out_of_range:
-            out[name] = [i for i in range(len(records)) if i not in out_of_range]
-    return out
+    return reach_of_materials(out_of_range(ranged, material_spheres(reach_rows(scene, rendered_objects(scene)))),
+                              len(records))
 
 
 def _reach_record(reach):

@@ -20,7 +20,7 @@ from ..core.ir.expr import FLOAT, Expr, Function, topological_order
 from ..core.ir.semantics import LEAVES
 from ..core.ir.tables import resolve
 from ..core.lut.lookup import LutSet
-from .common import IMAGE_PREFIX, STAMP_KEY, ensure_interface, socket_by_identifier
+from .common import IMAGE_PREFIX, STAMP_KEY, before_rebuild, ensure_interface, socket_by_identifier
 
 #: IR operation -> ShaderNodeMath.operation
 MATH_OPS = {
@@ -274,6 +274,7 @@ class _Emitter:
             self.groups[fn.key] = ng
             return ng
         else:
+            before_rebuild(ng)        # a light sync under way keeps a copy (common.node_groups_kept_on_error)
             ng.nodes.clear()
         self.fill(ng, fn.outputs, [n for n, _ in fn.inputs], fn.sockets,
                   {n: k for n, k in fn.inputs}, description=fn.description)
@@ -422,6 +423,7 @@ def ensure_tree(name, function, interface_inputs, sockets=None, internal_inputs=
     if ng is None:
         ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
     else:
+        before_rebuild(ng)
         ng.nodes.clear()
     _Emitter(tables).fill(ng, function.outputs, list(interface_inputs), sockets or function.sockets,
                           internal_inputs=internal_inputs, description=function.description, shader_sums=shader_sums)

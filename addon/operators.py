@@ -12,18 +12,6 @@ ERROR_STATES = ("corrupt", "mismatch")
 #: States that mean "bake again": the operator warns on these.
 WARNING_STATES = ("missing", "stale")
 
-BAKE_HINT = "bake them with `python scripts/bake_luts.py` or set another LUT directory in the preferences"
-
-
-def _summarise(statuses, states):
-    """``"corrupt: a, b; mismatch: c"`` for the tables in ``states``."""
-    parts = []
-    for state in states:
-        names = [s.name for s in statuses if s.state == state]
-        if names:
-            parts.append(f"{state}: {', '.join(names)}")
-    return "; ".join(parts)
-
 
 def _scene_exists(cls, context):
     """poll() of the operators that work on the active scene."""
@@ -76,16 +64,16 @@ class RTL_OT_lut_status(bpy.types.Operator):
             for status in statuses:
                 if status.state != "ok":
                     print(f"RT Lookdev: LUT {status.name} is {status.state}: {status.message}")
-            message = f"Unusable LUT tables in {lut_dir} ({_summarise(statuses, ERROR_STATES)})"
-            warnings = _summarise(statuses, WARNING_STATES)
+            message = f"Unusable LUT tables in {lut_dir} ({preferences.summarise_status(statuses, ERROR_STATES)})"
+            warnings = preferences.summarise_status(statuses, WARNING_STATES)
             if warnings:
                 message += f", also {warnings}"
             self.report({'ERROR'}, f"{message}: {errors[0].message}")
             return {'CANCELLED'}
 
-        warnings = _summarise(statuses, WARNING_STATES)
+        warnings = preferences.summarise_status(statuses, WARNING_STATES)
         if warnings:
-            self.report({'WARNING'}, f"LUT tables need baking in {lut_dir} ({warnings}); {BAKE_HINT}")
+            self.report({'WARNING'}, f"LUT tables need baking in {lut_dir} ({warnings}); {preferences.BAKE_HINT}")
             return {'FINISHED'}
 
         self.report({'INFO'}, f"All {len(statuses)} LUT tables are up to date in {lut_dir}")
@@ -165,14 +153,13 @@ class RTL_OT_sync_lights(bpy.types.Operator):
         return _scene_exists(cls, context)
 
     def execute(self, context):
-        from . import materials
+        from . import light_sync, materials
 
         lut_dir = preferences.lut_directory(context)
-        try:
-            records = materials.sync_scene_lights(context.scene)
-            groups = materials.rebuild_rt_lit_groups(context.scene, lut_dir)
-        except Exception as ex:
-            self.report({'ERROR'}, f"Could not sync lights: {ex}")
+        try:         # all or nothing: a failed sync changes no group or material (light_sync.sync_lights)
+            records, groups = light_sync.sync_lights(context.scene, lut_dir)
+        except light_sync.SyncError as ex:
+            self.report({'ERROR'}, str(ex))
             return {'CANCELLED'}
         message = f"RT Lit: {len(records)} lights [{_light_summary(records)}]; {len(groups)} RT Lit groups rebuilt"
         ignored = _ignored_settings(records)
@@ -183,6 +170,31 @@ class RTL_OT_sync_lights(bpy.types.Operator):
             self.report({'WARNING'}, f"{message}. {over}")
         else:
             self.report({'INFO'}, message)
+        return {'FINISHED'}
+
+
+class RTL_OT_light_sync_report(bpy.types.Operator):
+    """Show why the automatic light sync could not sync the lights (run by it after a failed sync: a depsgraph
+    handler cannot report; the RT Lookdev panels keep showing the message until a sync succeeds)"""
+
+    bl_idname = "rtl.light_sync_report"
+    bl_label = "Report Light Sync"
+    bl_options = {'INTERNAL'}
+
+    message: bpy.props.StringProperty(name="Message", options={'SKIP_SAVE'})
+
+    @classmethod
+    def poll(cls, context):
+        if context.window_manager is None:
+            cls.poll_message_set("No window manager to report to")
+            return False
+        return True
+
+    def execute(self, context):
+        if not self.message:
+            self.report({'INFO'}, "RT Lit: the lights are in sync")
+            return {'CANCELLED'}
+        self.report({'WARNING'}, self.message)
         return {'FINISHED'}
 
 
@@ -305,7 +317,7 @@ class RTL_OT_bake_luts(ModalTask, bpy.types.Operator):
         if not todo:
             self.report({'INFO'}, f"All {len(catalog.TABLES)} LUT tables in {lut_dir} are current; nothing to bake")
             return {'FINISHED'}
-        force = self.force
+        force, scene = self.force, context.scene
 
         def work(progress):
             def step(group, done, total):
@@ -318,14 +330,25 @@ class RTL_OT_bake_luts(ModalTask, bpy.types.Operator):
             return records
 
         def finish(records):
+            from . import light_sync
+
             preferences.refresh_status(lut_dir)
             baked = [r for r in records if r.state == "baked"]
             seconds = sum(r.seconds for r in baked)
-            self.report({'INFO'}, f"Baked {', '.join(r.group for r in baked)} into {lut_dir} in {seconds:.0f} s; "
-                                  "Sync Lights rebuilds the RT Lit groups with them")
+            message = f"Baked {', '.join(r.group for r in baked)} into {lut_dir} in {seconds:.0f} s"
+            if light_sync.failure(scene) is None:
+                self.report({'INFO'}, f"{message}; Sync Lights rebuilds the RT Lit groups with them")
+                return {'FINISHED'}
+            try:         # a light sync failed for want of these tables: sync now
+                light_sync.sync_lights(scene, lut_dir)
+            except light_sync.SyncError as ex:
+                self.report({'WARNING'}, f"{message}. {ex}")
+            else:
+                self.report({'INFO'}, f"{message}; the lights are synced with them")
             return {'FINISHED'}
 
         return self.start_task(context, work, finish)
 
 
-classes = (RTL_OT_lut_status, RTL_OT_bake_luts, RTL_OT_sync_lights, RTL_OT_sync_world, RTL_OT_add_node_groups)
+classes = (RTL_OT_lut_status, RTL_OT_bake_luts, RTL_OT_sync_lights, RTL_OT_light_sync_report, RTL_OT_sync_world,
+           RTL_OT_add_node_groups)

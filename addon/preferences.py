@@ -23,6 +23,10 @@ STATE_ICONS = {
     "mismatch": 'CANCEL',
 }
 
+#: Where the extension bakes the tables: what a message about unusable tables suggests (its zip has no scripts/).
+BAKE_HINT = ("bake them with Bake LUTs (Edit > Preferences > Add-ons > RT Lookdev, or the button in the RT Lookdev "
+             "panel) or set another LUT directory there")
+
 # Last status per LUT directory (str path -> list[LutStatus]).  Filled lazily by
 # draw() and refreshed by RTL_OT_lut_status, so redraws do not re-read the tables.
 _status_cache: dict[str, list] = {}
@@ -57,6 +61,16 @@ def refresh_status(lut_dir: Path) -> list:
     statuses = list(catalog.lut_status(lut_dir))
     _status_cache[str(lut_dir)] = statuses
     return statuses
+
+
+def summarise_status(statuses, states):
+    """``"corrupt: a, b; mismatch: c"``: the tables of ``statuses`` in each of ``states``."""
+    parts = []
+    for state in states:
+        names = [s.name for s in statuses if s.state == state]
+        if names:
+            parts.append(f"{state}: {', '.join(names)}")
+    return "; ".join(parts)
 
 
 def cached_status(lut_dir: Path) -> list:

@@ -13,10 +13,10 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, PointerProperty
 
 from ..core.materials.rt_lit_interface import Features
-from . import convert
+from . import convert, convert_ui
 
-_ENUMS = {"specular": convert.SPECULAR_ITEMS, "diffuse": convert.DIFFUSE_ITEMS,
-          "environment_ms": convert.ENVIRONMENT_MS_ITEMS, "sheen": convert.SHEEN_ITEMS}
+_ENUMS = {"specular": convert_ui.SPECULAR_ITEMS, "diffuse": convert_ui.DIFFUSE_ITEMS,
+          "environment_ms": convert_ui.ENVIRONMENT_MS_ITEMS, "sheen": convert_ui.SHEEN_ITEMS}
 
 
 def _features(material):

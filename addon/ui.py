@@ -1,7 +1,30 @@
-"""The RT Lookdev panels in the material and world properties."""
+"""The RT Lookdev panels in the material and world properties, and what they show of the light sync."""
 from __future__ import annotations
 
+import textwrap
+
 import bpy
+
+#: Characters per line of a message in a panel (labels do not wrap).
+LINE_WIDTH = 52
+
+
+def draw_light_sync_failure(layout, scene):
+    """The last failed light sync of ``scene`` (addon/light_sync.py), if any: its message, and the ways out (Bake LUTs
+    when the tables are the cause, Sync Lights); nothing while the lights are in sync."""
+    from . import light_sync
+
+    failed = light_sync.failure(scene)
+    if failed is None:
+        return
+    box = layout.box()
+    col = box.column(align=True)
+    for i, line in enumerate(textwrap.wrap(failed.message, LINE_WIDTH, break_on_hyphens=False)):
+        col.label(text=line, icon='ERROR' if i == 0 else 'BLANK1')
+    row = box.row(align=True)
+    if failed.luts:
+        row.operator("rtl.bake_luts", icon='RENDER_STILL')
+    row.operator("rtl.sync_lights", icon='FILE_REFRESH')
 
 
 class _PropertiesPanel:
@@ -19,16 +42,17 @@ class RTL_PT_material(_PropertiesPanel, bpy.types.Panel):
         return context.material is not None
 
     def draw(self, context):
-        from . import convert
+        from . import convert, convert_ui
         from .common import FEATURES_KEY
 
         layout = self.layout
         mat = context.material
+        draw_light_sync_failure(layout, context.scene)
         col = layout.column(align=True)
         if convert.is_rt_lit_material(mat):
             switches = getattr(mat, "rtl_switches", None)
             if switches is not None:          # editing a switch rebuilds the group (addon/switches.py)
-                convert.draw_switches(col, switches)
+                convert_ui.draw_switches(col, switches)
             else:
                 col.label(text="RT Lit: " + ", ".join(f"{k} {v}" for k, v in dict(mat.get(FEATURES_KEY, {})).items()))
             col.operator("rtl.convert_to_principled", icon='MATERIAL')

@@ -3,8 +3,8 @@
 This is where the material's inputs are guarded, once, as Filament's ``getPixelParams`` does: factors
 and reflectance colours are clamped to [0, 1] (a NaN input becomes 0: min and max ignore NaN,
 core/shading_ops.py), the emission to [0, EMISSION_MAX], the shading normal and the view direction
-normalised (a Normal input shorter than NORMAL_MIN, zero or denormal, falls back to the geometry's
-normal).  The lobes downstream only add the guards their own math needs to stay
+normalised (a Normal input shorter than NORMAL_MIN, zero or denormal, or as long as NORMAL_MAX, infinite or
+NaN, falls back to the geometry's normal).  The lobes downstream only add the guards their own math needs to stay
 finite (``conventions.ALPHA_MIN``, cosine floors).
 """
 from __future__ import annotations
@@ -26,6 +26,10 @@ def dielectric_f0(ior, level):
 #: denormals, so that float32 and float64 take the same branch (at |n| = 1e-40 the float32 dot
 #: product underflows to 0 while float64's does not; docs/robustness.md).
 NORMAL_MIN = 1e-6
+#: Normal inputs this long or longer fall back to the geometry's normal too: an infinite component makes the
+#: length infinite and n / |n| NaN (inf / inf), and from |n| ~ 1.8e19 on the float32 dot product overflows to inf
+#: while float64's does not; below 1e18 both precisions compute |n|^2 (at most 1e36) and take the same branch.
+NORMAL_MAX = 1e18
 #: Emission colour and strength are each clamped to [0, EMISSION_MAX], so their product stays finite in
 #: float32 (3.4e38) whatever a texture or driver feeds them.
 EMISSION_MAX = 1e18
@@ -46,8 +50,9 @@ def _surface(**kw):
     metallic = op.saturate(kw["Metallic"])
     base, tint = _reflectance(kw["Base Color"]), _reflectance(kw["Specular Tint"])
     n_in = kw["Normal"]
-    n = op.vselect(op.greater(op.dot(n_in, n_in), NORMAL_MIN * NORMAL_MIN), op.normalize(n_in),
-                   op.normalize(kw["Geometry Normal"]))
+    length2 = op.dot(n_in, n_in)       # NaN fails both comparisons: the geometry's normal
+    usable = op.logical_and(op.greater(length2, NORMAL_MIN * NORMAL_MIN), op.less(length2, NORMAL_MAX * NORMAL_MAX))
+    n = op.vselect(usable, op.normalize(n_in), op.normalize(kw["Geometry Normal"]))
     f0_dielectric = op.scale(tint, dielectric_f0(kw["IOR"], kw["Specular IOR Level"]))
     f0 = op.scale(f0_dielectric, 1.0 - metallic) + op.scale(base, metallic)
     return {

@@ -283,7 +283,11 @@ def test_light_sync_benchmark_writes_its_report(bpy_module, tmp_path, lut_dir):
 
     out = tmp_path / "light_sync.md"
     result = light_sync_benchmark.run(light_sync_benchmark.parse_args(
-        ["--objects", "12", "--lights", "3", "--repeats", "5", "--lut-dir", str(lut_dir), "--out", str(out)]),
-        log=lambda line: None)
+        ["--objects", "12", "--lights", "3", "--repeats", "5", "--runs", "2", "--lut-dir", str(lut_dir),
+         "--out", str(out)]), log=lambda line: None)
     assert out.read_text().startswith("# Automatic light sync") and out.with_suffix(".json").is_file()
-    assert result["no_change_check_ms"] > 0.0 and result["resync_adding_a_light_ms"] > 0.0
+    scene = result["scenes"][0]
+    assert scene["objects"] == 12 and scene["resync_adding_a_light_ms"] > 0.0
+    for ranges in ("without_ranges", "with_ranges"):
+        figures = scene["handler_ms"][ranges]
+        assert set(figures) >= set(light_sync_benchmark.UPDATES) and all(figures[k] > 0.0 for k in light_sync_benchmark.UPDATES)

@@ -105,7 +105,7 @@ def _principled_material(bpy, name="Lookdev", *, subsurface=SUBSURFACE_WEIGHT):
     return mat
 
 
-from rt_lookdev.addon.convert import _value  # noqa: E402  (the same reading as the module under test)
+from rt_lookdev.addon.common import socket_value as _value  # noqa: E402  (the same reading as the module under test)
 
 
 def _close(a, b, tol=1e-6):
@@ -323,11 +323,13 @@ def test_back_conversion_without_kept_principled_creates_one(bpy_module, convert
 
 @pytest.fixture
 def operators(bpy_module, convert, factory, monkeypatch):
+    from rt_lookdev.addon import convert_ui
+
     monkeypatch.setattr(convert, "default_group_factory", lambda lut_dir=None: factory)
-    for cls in convert.classes:
+    for cls in convert_ui.classes:
         bpy_module.utils.register_class(cls)
     yield bpy_module.ops.rtl
-    for cls in reversed(convert.classes):
+    for cls in reversed(convert_ui.classes):
         bpy_module.utils.unregister_class(cls)
 
 
@@ -343,7 +345,7 @@ def _object_with(bpy, scene, *materials):
 
 
 def test_operators(bpy_module, empty_scene, convert, factory, operators):
-    from rt_lookdev.addon.convert import RTL_OT_convert_to_principled, RTL_OT_convert_to_rt_lit
+    from rt_lookdev.addon.convert_ui import RTL_OT_convert_to_principled, RTL_OT_convert_to_rt_lit
 
     assert RTL_OT_convert_to_rt_lit.bl_idname == "rtl.convert_to_rt_lit"
     assert RTL_OT_convert_to_principled.bl_idname == "rtl.convert_to_principled"

@@ -44,7 +44,7 @@ def test_demo_scene_round_trips_and_reloads(empty_scene, lut_dir, tmp_path):
     # back to Principled: every input equals what the demo built it with
     for name in spheres:
         mat = bpy.data.materials[name]
-        kept = convert._kept_principled(mat.node_tree)
+        kept = convert.kept_principled(mat.node_tree)
         before = _principled_values(kept)
         result = convert.rt_lit_to_principled(mat)
         assert result.status == "converted"

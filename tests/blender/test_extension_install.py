@@ -12,7 +12,7 @@ from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
 OPERATORS = ["add_node_groups", "add_path_traced_twin", "bake_luts", "convert_to_principled", "convert_to_rt_lit", "export_luts",
-             "export_scene", "lut_status", "new_lookdev_scene", "sync_lights", "sync_world"]
+             "export_scene", "light_sync_report", "lut_status", "new_lookdev_scene", "sync_lights", "sync_world"]
 
 pytestmark = pytest.mark.blender
 

@@ -94,6 +94,8 @@ def test_material_finite_non_negative_bounded(tables, family, kind, seed):
 @example(name="Roughness", special=np.nan, kind="quad")
 @example(name="Base Color", special=-1.0, kind="disk")
 @example(name="Emission Strength", special=np.inf, kind="sun")
+@example(name="Normal", special=np.inf, kind="point")       # regression: NaN under point and sun lights
+@example(name="Normal", special=-np.inf, kind="sun")
 def test_nan_and_inf_inputs_finite(tables, name, special, kind):
     """Regression: a NaN or infinite material input (a texture, a driver) reached the pixel."""
     family = robustness.FAMILIES[-1]

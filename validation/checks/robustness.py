@@ -342,6 +342,10 @@ FINDINGS = (
     ("Denormal normals (|n| ~ 1e-40) shaded with an arbitrary normal in float64 and the geometry's in float32",
      "RTL Surface's zero-normal test dot(n, n) > 0 underflows in float32 only", "threshold |n| > 1e-6 "
      "(surface.NORMAL_MIN)", "test_denormal_normal_falls_back"),
+    ("An infinite Normal input gave NaN under point and sun lights in float32 (quads and disks stayed finite)",
+     "RTL Surface normalised any normal longer than NORMAL_MIN: inf / inf", "normals as long as 1e18 or longer "
+     "(infinite, NaN, or where float32's dot product overflows) fall back to the geometry's normal too "
+     "(surface.NORMAL_MAX)", "test_nan_and_inf_inputs_finite"),
     ("Quads much larger than their distance to the point went dark (a 10^4 m panel 1 cm above it: 0 where the "
      "form factor is ~1) or, in Cycles, black on one backend and lit on the other (90 of 12.2 M sweep pixels)",
      "ltc/polygon.py: the side and edge-on tests measured from corner p0 (as ltc_code), whose float32 rounding "
