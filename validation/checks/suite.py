@@ -52,6 +52,10 @@ Outputs in --out (default out/validation): <case>/{node_a.exr, numpy_b.exr, trut
 truth_seed*.exr, cycles_passes.exr, a.png, c.png, err_ac.png, err_ab.png}, furnace/,
 validation.json, validation.csv, report.html.
 
+Where the cases run (validation/harness/distribute.py): each case is a task (``run_task``: its random generator
+seeded from --seed and its name), on a Dask LocalCluster with one worker per core by default, here with
+--workers 0, or on a running scheduler with --scheduler ADDRESS; the figures are the same wherever they ran.
+
 Usage:
     python scripts/validate.py [--quick] [--cases NAME ...] [--cell 64] [--samples 512] [--out DIR] ...
     blender --background --python scripts/validate.py -- [same options]   (needs OpenEXR importable)
@@ -60,20 +64,21 @@ Full suite: about 4-5 minutes on 2 cores (timings in the report).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import time
+import zlib
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..harness import metrics, outputs, scene_render
+from ..harness import distribute, metrics, outputs
 from . import suite_cases as suite, suite_html
 from . import suite_brute_force
 from . import suite_metrics
 from . import suite_scene
-from . import energy_render as ve
-from ...core import energy_checks as core_validation
-from ...core import multiscatter
+from .suite_furnace import run_furnace
 from ...core.lut import lookup
 
 DEFAULTS = {"ab_tol": 1e-4, "ab_atol": 1e-6, "lambert_median": 0.005, "ggx_quad_median": 0.02,
@@ -241,72 +246,29 @@ def run_case(case, args, out_dir, rng, tables, log=print):
     return result, pooled_parts
 
 
-# --- furnace -----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CaseTask:
+    """One case of the suite as a task (``distribute.map_tasks``): the case and nothing else it depends on."""
+    case: object
 
-def run_furnace(args, out_dir, log=print):
-    folder = out_dir / "furnace"
-    roughness = (0.25, 0.5, 0.75, 1.0)
-    t0 = time.perf_counter()
-    energy = ve.measure(resolution=args.furnace_cell, samples=args.furnace_samples, roughness=roughness,
-                    out_dir=folder, lut_dir=args.lut_dir, seeds=tuple(args.seeds), threads=args.threads,
-                    exact=False, log=lambda s: None)
-    t_energy = time.perf_counter() - t0
-    ms = {k: {"mean": v["mean"], "se": v["se"], "ok": v["ok"]} for k, v in energy["MULTI_GGX"].items()}
-    ms_ok = all(abs(v["mean"] - 1.0) <= args.furnace_tol for v in ms.values())
 
-    tables, _ = ve.energy_tables(args.lut_dir)
-    mu = np.linspace(0.1, 1.0, 10)
-    t0 = time.perf_counter()
-    kc = core_validation.kulla_conty_furnace(tables, np.array(roughness), mu)
-    kc_max = {f"{r:g}": float(np.max(np.abs(row))) for r, row in zip(roughness, kc)}
-    t_kc = time.perf_counter() - t0
+@functools.lru_cache(maxsize=4)
+def _tables(lut_dir):
+    return lookup.LutSet.from_folder(lut_dir)
 
-    # Kulla-Conty coloured albedo vs Cycles Multiscatter GGX with Color = c (constant Fresnel c):
-    # Cycles: c E + c^2 E_avg (1 - E)/(1 - c (1 - E_avg)) = c E + F_ms(c) (1 - E), the KC albedo.
-    color = (0.9, 0.6, 0.3)
-    t0 = time.perf_counter()
-    scene, glossies = ve.build_scene(roughness, args.furnace_cell)
-    for g in glossies:
-        g.distribution = "MULTI_GGX"
-        g.inputs["Color"].default_value = color + (1.0,)
-    pair = []
-    for seed in args.seeds[:2]:
-        ve.configure_render(scene, args.furnace_samples, seed, args.threads)
-        path = folder / f"kc_color_seed{seed}.exr"
-        scene_render.render_exr(scene, path)
-        pair.append(scene_render.read_passes(path))
-    (ca, na), (cb, nb) = pair
-    h, w = ca.shape[:2]
-    sphere, _ = ve.pixel_geometry(w, h, len(roughness))
-    nrm = 0.5 * (na + nb)
-    length = np.linalg.norm(nrm, axis=-1)
-    max_rel = {}
-    for i, r in enumerate(roughness):
-        sel = (sphere == i) & (length > 0.5)
-        m = np.clip((nrm[sel] / length[sel, None]) @ ve.VIEW, 0.0, 1.0)
-        cyc = 0.5 * (ca[sel] + cb[sel])
-        e = tables.e(m, np.full_like(m, r))
-        om_avg = float(tables.one_minus_e_avg(np.array([r]))[0])
-        pred = np.stack([ch * e + multiscatter.kulla_conty_fresnel_factor(ch, om_avg) * (1.0 - e) for ch in color], -1)
-        worst = 0.0
-        for lo, hi in zip(ve.MU_EDGES[1:-1], ve.MU_EDGES[2:]):
-            s = (m >= lo) & ((m < hi) if hi < 1 else (m <= hi))
-            if s.sum() > 10:
-                worst = max(worst, float(np.max(np.abs(cyc[s].mean(0) / pred[s].mean(0) - 1.0))))
-        max_rel[f"{r:g}"] = worst
-    t_color = time.perf_counter() - t0
-    kc_color = {"color": list(color), "max_rel_bin": max_rel,
-                "ok": all(v <= args.furnace_tol for v in max_rel.values())}
-    out = {"settings": f"{args.furnace_cell} px per sphere, {args.furnace_samples} spp x {len(args.seeds)} seeds",
-           "validate_energy_passed": bool(energy["passed"]), "multi_ggx": ms, "multi_ggx_ok": bool(ms_ok),
-           "kc_lut_max_abs": kc_max, "kc_lut_ok": all(v <= args.furnace_tol for v in kc_max.values()),
-           "kc_color": kc_color,
-           "times_s": {"validate_energy": t_energy, "kc_lut": t_kc, "kc_color_render": t_color}}
-    ms_text = ", ".join(f"{k}: {v['mean']:.4f}" for k, v in ms.items())
-    log(f"[validate] furnace: MS GGX {ms_text}; "
-        f"KC LUT max |E-1| {max(kc_max.values()):.1e}; KC colour vs Cycles max {max(max_rel.values()):.3%} "
-        f"({t_energy + t_kc + t_color:.1f} s)")
-    return out
+
+def case_rng(seed, name):
+    """The random generator of one case (its brute-force pixels): seeded from the suite's seed and the case's name,
+    so a case picks the same pixels whichever cases run with it, in whichever order, wherever."""
+    return np.random.default_rng([seed, zlib.crc32(name.encode())])
+
+
+def run_task(task, args):
+    """One case (``run_case``) from the task and the options alone: {"result", "parts", "log"}."""
+    lines = []
+    result, parts = run_case(task.case, args, Path(args.out), case_rng(args.seed, task.case.name),
+                             _tables(args.lut_dir), lines.append)
+    return {"result": result, "parts": parts, "log": lines}
 
 
 # --- driver ------------------------------------------------------------------------------------
@@ -497,6 +459,7 @@ def parse_args(argv):
     p.add_argument("--furnace-cell", type=int, default=64)
     p.add_argument("--furnace-samples", type=int, default=64)
     p.add_argument("--lut-dir", default=None)
+    distribute.add_arguments(p)
     for k, v in DEFAULTS.items():
         p.add_argument("--" + k.replace("_", "-"), type=float, default=v)
     return p.parse_args(argv)
@@ -509,13 +472,13 @@ def run(args, log=print):
     cases = suite.build_cases(args.seed, quick=args.quick)
     if args.cases:
         cases = [c for c in cases if any(s in c.name for s in args.cases)]
-    rng = np.random.default_rng(args.seed)
-    tables = lookup.LutSet.from_folder(args.lut_dir)
-    results, pooled_parts = [], []
-    for case in cases:
-        r, parts = run_case(case, args, out_dir, rng, tables, log)
-        results.append(r)
-        pooled_parts += parts
+    args.out = str(out_dir.resolve())              # the same folder for tasks run in other processes
+    tables = _tables(args.lut_dir)
+    records = distribute.map_tasks(f"{__name__}:run_task", [CaseTask(c) for c in cases], args, progress=log,
+                                   label=lambda task: task.case.name,
+                                   on_record=lambda task, record: [log(line) for line in record["log"]])
+    results = [record["result"] for record in records]
+    pooled_parts = [part for record in records for part in record["parts"]]
     furnace = None if args.skip_furnace else run_furnace(args, out_dir, log)
     groups = {}
     for p in pooled_parts:
@@ -534,7 +497,8 @@ def run(args, log=print):
         "passed": all(c["ok"] for c in checks), "checks": checks, "pooled": pooled,
         "pooled_by_light": pooled_by_light, "furnace": furnace,
         "cases": results,
-        "settings": {"blender": bpy.app.version_string, "threads": args.threads, "cell_px": args.cell,
+        "settings": {"blender": bpy.app.version_string, "ran": distribute.where(args), "threads": args.threads,
+                     "cell_px": args.cell,
                      "samples": args.samples, "seeds": list(args.seeds), "seed": args.seed, "quick": args.quick,
                      "brute_pixels": args.brute_pixels, "panels": args.panels, "order": args.order,
                      "segments": args.segments, "floor": args.floor, "floor_wide": args.floor_wide,

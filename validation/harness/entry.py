@@ -10,12 +10,10 @@ A check (validation/checks/) or benchmark (validation/benchmarks/) module define
     to_markdown(result) -> str                 the result as Markdown (what the main job's report and
                                                docs/benchmarks/ show).
 
-``progress`` receives one line of text at a time.  A sweep of independent cases (the suite's cases, the world
-suite's worlds) also exposes them, so that they can run anywhere (``run_tasks``):
+``progress`` receives one line of text at a time.  A sweep of independent cases (the suite's cases) also defines
 
-    tasks(args) -> list                        the cases, as data (dataclasses of numbers and strings);
-    run_task(task, args, ...) -> dict          one case: a JSON-able record, from the task and the options alone;
-    combine(args, records) -> dict             the records pooled and gated: ``run``'s result.
+    run_task(task, args) -> record             one case, from the task (data) and the options alone: a picklable
+                                               record, so that ``distribute.map_tasks`` can run it anywhere.
 
 ``scripts/<name>.py`` is then ``sys.exit(entry.main(module, sys.argv[1:]))``.
 """
@@ -48,8 +46,3 @@ def main(module, argv, progress=flush_log):
     args = module.parse_args(script_arguments(argv))
     return exit_code(module.run(args, progress))
 
-
-def run_tasks(run_task, tasks, args, progress=flush_log, **shared):
-    """``run_task(task, args, **shared)`` for every task, in order, here: the records.  The one place a sweep's
-    cases are mapped; running them elsewhere (worker processes, a cluster) replaces this map."""
-    return [run_task(task, args, progress=progress, **shared) for task in tasks]

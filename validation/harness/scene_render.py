@@ -11,7 +11,12 @@ from . import exr_images
 
 def uv_sphere_mesh(name, segments, rings, radius=1.0):
     """A smooth UV sphere mesh of ``radius`` with exactly radial vertex normals (Blender's default ones are
-    angle-weighted face averages, close to radial but not equal near the poles)."""
+    angle-weighted face averages, close to radial but not equal near the poles).
+
+    The normals are a "free" custom normal (the float attribute ``custom_normal`` on the points, Blender 4.5+), not
+    ``normals_split_custom_set_from_vertices``: that one stores them encoded in each corner's fan space, off by up to
+    4e-4, and differently from one call to the next (four meshes built in a row got four sets of normals, bpy 5.2.3),
+    so two runs of a check rendered different normals and their figures differed in the fourth digit."""
     import bmesh
     import bpy
 
@@ -21,7 +26,12 @@ def uv_sphere_mesh(name, segments, rings, radius=1.0):
     bm.to_mesh(mesh)
     bm.free()
     mesh.shade_smooth()
-    mesh.normals_split_custom_set_from_vertices([v.co.normalized() for v in mesh.vertices])
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    normals = co / np.linalg.norm(co, axis=1, keepdims=True)
+    mesh.attributes.new("custom_normal", "FLOAT_VECTOR", "POINT").data.foreach_set(
+        "vector", normals.astype(np.float32).ravel())
     return mesh
 
 
