@@ -15,8 +15,6 @@
 """
 from __future__ import annotations
 
-import math
-
 import bpy
 import numpy as np
 

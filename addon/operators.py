@@ -153,7 +153,7 @@ class RTL_OT_sync_lights(bpy.types.Operator):
         return _scene_exists(cls, context)
 
     def execute(self, context):
-        from . import light_sync, materials
+        from . import light_sync
 
         lut_dir = preferences.lut_directory(context)
         try:         # all or nothing: a failed sync changes no group or material (light_sync.sync_lights)
