@@ -352,6 +352,9 @@ def write_report(job, out_dir):
     speed = job.get("speed_error")
     lines += ["## Speed vs error (quick): equal-error speedup over path tracing", ""]
     lines += [speed["summary_markdown"], ""] if speed else ["Skipped (--skip-render).", ""]
+    if job.get("step_seconds"):
+        lines += ["## Time per step", "", "| step | seconds |", "|---|---|"]
+        lines += [f"| {key} | {seconds:.1f} |" for key, seconds in job["step_seconds"].items()] + [""]
     lines += [f"Overall: **{'PASS' if job['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
@@ -379,32 +382,47 @@ def _passed(job):
                                   "world_validation", "robustness", "speed_error")))
 
 
+#: The Cycles render check's (pixels per sphere, samples) in the quick main job (--full: the check's own defaults, 256
+#: and 256): its four renders took 197 s of a 1166 s quick run at full size (2026-12-03, 2 cores).
+QUICK_RENDER = (128, 64)
+
+
+def _timed(job, key, step, *args, **kwargs):
+    """``job[key] = step(*args, **kwargs)``, its wall time in ``job["step_seconds"][key]``."""
+    t0 = time.perf_counter()
+    job[key] = step(*args, **kwargs)
+    job.setdefault("step_seconds", {})[key] = round(time.perf_counter() - t0, 1)
+    return job[key]
+
+
 def run(args, log=entry.flush_log):
     """Every step, then the report (``args.out``/report.md, report.json).  Returns the report dict; when
     the LUTs are not usable, stops after step 1 with ``{"luts": ..., "passed": False}`` (no report)."""
     t0 = time.perf_counter()
     job = {"date": time.strftime("%Y-%m-%d %H:%M:%S"), "mode": "full" if args.full else "quick"}
-    job["luts"] = step_luts(args.lut_dir, log)
+    _timed(job, "luts", step_luts, args.lut_dir, log)
     if not job["luts"]["passed"]:
         print("LUTs are not usable; see the status above", file=sys.stderr)
         job["passed"] = False
         return job
-    job["numpy_checks"] = step_numpy_checks(args.lut_dir, log)
-    job["ltc"] = step_ltc(args.lut_dir, log)
-    job["lut_export"] = step_lut_export(args.out, args.lut_dir, log)
+    _timed(job, "numpy_checks", step_numpy_checks, args.lut_dir, log)
+    _timed(job, "ltc", step_ltc, args.lut_dir, log)
+    _timed(job, "lut_export", step_lut_export, args.out, args.lut_dir, log)
     job["render"] = job["demo"] = job["lookdev_twin"] = job["validation"] = job["world_validation"] = None
     job["speed_error"] = None
+    quick_resolution, quick_samples = (None, None) if args.full else QUICK_RENDER
     if not args.skip_render:
-        job["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
-        job["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
-        job["lookdev_twin"] = step_lookdev_twin(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
-    job["realtime_benchmark"] = step_realtime_benchmark(args.out, log)
+        _timed(job, "render", step_render, args.out, args.lut_dir, args.render_resolution or quick_resolution,
+               args.render_samples or quick_samples, log)
+        _timed(job, "demo", step_demo, args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+        _timed(job, "lookdev_twin", step_lookdev_twin, args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+    _timed(job, "realtime_benchmark", step_realtime_benchmark, args.out, log)
     if not args.skip_render:
-        job["validation"] = step_validation(args.out, args.lut_dir, log, args.full)
-        job["world_validation"] = step_world_validation(args.out, args.lut_dir, log, args.full)
-    job["robustness"] = step_robustness(args.out, args.lut_dir, log)
+        _timed(job, "validation", step_validation, args.out, args.lut_dir, log, args.full)
+        _timed(job, "world_validation", step_world_validation, args.out, args.lut_dir, log, args.full)
+    _timed(job, "robustness", step_robustness, args.out, args.lut_dir, log)
     if not args.skip_render:
-        job["speed_error"] = step_speed_error(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+        _timed(job, "speed_error", step_speed_error, args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
     job["passed"] = _passed(job)
     job["seconds"] = time.perf_counter() - t0
     log("[13/13] report")
