@@ -18,7 +18,6 @@ classes = (
     *preferences.classes,
     *switches.classes,
     *ui.classes,
-    *light_controls.classes,
 )
 #: (menu, draw function): entries appended to Blender's menus (File > Export, 3D viewport > Add).
 menus = (*export_operators.menus, *lookdev_operators.menus)

@@ -7,7 +7,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, St
 
 from . import lookdev_scene, preferences
 from .convert_ui import DIFFUSE_ITEMS, SPECULAR_ITEMS
-from .operators import _lut_directory_exists
+from .operators import lut_directory_exists
 from ..core.materials.rt_lit_interface import Features
 
 
@@ -42,7 +42,7 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _lut_directory_exists(cls, context)
+        return lut_directory_exists(cls, context)
 
     def invoke(self, context, event):
         if "studio" in lookdev_scene.studio_hdris():

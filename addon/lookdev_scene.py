@@ -17,7 +17,7 @@ every other object (lights, camera, other materials, no material) is the object 
 light-linking collections of the lights and emitters with their originals' states, so light and shadow linking
 act on the twin as on the scene.  It renders with Cycles path tracing, by default direct light only (0 bounces:
 what RT Lit computes, plus the shadows it does not), so switching scenes compares real-time and path-traced
-shading.  ``validation.lookdev_twin`` measures the two against each other.  Not twinned: materials a modifier
+shading.  ``validation.checks.lookdev_twin`` measures the two against each other.  Not twinned: materials a modifier
 assigns (Geometry Nodes' Set Material), particle instances, and the view layers' collection settings (exclude
 aside: an object the scene does not render is left out); a light-linking collection that a scene renders cannot
 hold the copies, and the twin is refused.

@@ -21,7 +21,7 @@ def _scene_exists(cls, context):
     return True
 
 
-def _lut_directory_exists(cls, context):
+def lut_directory_exists(cls, context):
     """poll() of the operators that read the LUT folder: it must exist."""
     lut_dir = preferences.lut_directory(context)
     if not lut_dir.is_dir():
@@ -39,7 +39,7 @@ class RTL_OT_lut_status(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _lut_directory_exists(cls, context)
+        return lut_directory_exists(cls, context)
 
     def execute(self, context):
         lut_dir = preferences.lut_directory(context)
@@ -208,7 +208,7 @@ class RTL_OT_add_node_groups(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _lut_directory_exists(cls, context)
+        return lut_directory_exists(cls, context)
 
     def execute(self, context):
         from ..core.lut.lookup import LutSet

@@ -1,4 +1,4 @@
-"""The RT Lookdev panels in the material and world properties, and what they show of the light sync."""
+"""The RT Lookdev panels in the material, world and light properties, and what they show of the light sync."""
 from __future__ import annotations
 
 import textwrap
@@ -90,4 +90,41 @@ class RTL_PT_world(_PropertiesPanel, bpy.types.Panel):
         layout.operator("rtl.sync_world", icon='WORLD')
 
 
-classes = (RTL_PT_material, RTL_PT_world)
+class RTL_PT_light(bpy.types.Panel):
+    """RT Lookdev's controls of a light: range, cone falloff, quad-to-spot fallback."""
+    bl_label = "RT Lookdev"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context, "light", None) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        data = context.light
+        draw_light_sync_failure(layout, context.scene)      # a light added or changed may be what failed to sync
+        if data.type == 'SUN':
+            layout.label(text="RT Lit has no controls for sun lights", icon='INFO')
+            return
+        area = data.type == 'AREA'
+        quad = area and data.shape in ('SQUARE', 'RECTANGLE')
+        col = layout.column()
+        row = col.row(align=True)
+        row.prop(data, "rtl_use_range")
+        sub = row.row(align=True)
+        sub.active = data.rtl_use_range
+        sub.prop(data, "rtl_range", text="")
+        if area:
+            col.prop(data, "rtl_use_cone")
+            if quad:
+                col.prop(data, "rtl_spot_fallback")
+            angles = col.column(align=True)
+            angles.active = data.rtl_use_cone or (quad and data.rtl_spot_fallback)
+            angles.prop(data, "rtl_cone_inner")
+            angles.prop(data, "rtl_cone_outer")
+        col.label(text="RT Lit materials follow after Sync Lights (automatic by default)", icon='INFO')
+
+
+classes = (RTL_PT_material, RTL_PT_world, RTL_PT_light)

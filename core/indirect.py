@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from . import shading_ops as op
+from .conventions import ALPHA_MIN
 from .diffuse import cod_multiscatter_diffuse, cod_wrapped_diffuse_cosine
 from .ltc import polygon
 
@@ -254,8 +255,6 @@ def cod_diffuse_reference(coeffs, n, v, roughness, n_theta=64, n_phi=128):
     coeffs (..., 9, 3), n and v (..., 3) unit, roughness (...) -> (..., 3).  The integrand is smooth
     (the BRDF has no peak: its retro-reflection term decays in sqrt(n.h)), so 64 x 128 points give
     ~1e-6 relative (tested against a finer rule)."""
-    from .conventions import ALPHA_MIN
-
     n = np.asarray(n, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
     r = np.asarray(roughness, dtype=np.float64)
@@ -281,8 +280,6 @@ def cod_wrapped_diffuse_reference(coeffs, n, v, roughness, wrap, n_theta=64, n_p
     under the SH radiance: int L(l) f_w(l, v) mu_l dl over the directions with n.l > -w, where it is non-zero
     (Gauss-Legendre in z = n.l on [-w, 1], so the rule does not straddle the kink at z = -w; midpoint rule in
     phi).  ``wrap``: a float; numpy, float64; shapes as ``cod_diffuse_reference``."""
-    from .conventions import ALPHA_MIN
-
     w = float(np.clip(wrap, 0.0, 1.0))
     n = np.asarray(n, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)

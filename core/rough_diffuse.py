@@ -190,7 +190,7 @@ MS_KERNEL_ZONAL = (1.0, 0.740051590, 0.378505935)
 # approximates it for every roughness (Heitz et al. 2016: an LTC with Minv = diag(1, 1, c3) is isotropic about N);
 # c3 minimises the total-variation distance to the kernel (``ms_kernel_ltc_tv``): 0.0585, against 0.130 for the
 # plain cosine (c3 = 1).  Against Cycles the centre form measured better (docs/rough_diffuse.md), so this LTC is
-# kept for that comparison (validation/ltc_benchmark.py).
+# kept for that comparison (validation/benchmarks/ltc_benchmark.py).
 
 def ms_kernel_ltc_tv(c3, n=20000):
     """Total-variation distance 1/2 int |ms_kernel - D_ltc| dw between the kernel and the isotropic LTC

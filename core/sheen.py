@@ -9,7 +9,7 @@ the view in the XZ plane towards +X), and a scale, the directional albedo R(mu_v
 
 for l = (x, y, z): the LTC density |det Minv| D_o(Minv l / |Minv l|) / |Minv l|^3 with D_o the clamped
 cosine / pi (Heitz et al. 2016, eq. 1-4).  (a, b, R) come from the paper's fitted table as Cycles reads it,
-measured from Cycles into the table ``zeltner_sheen`` (validation/sheen_table.py, docs/luts.md).
+measured from Cycles into the table ``zeltner_sheen`` (validation/benchmarks/sheen_table.py, docs/luts.md).
 
 Cycles clamps the sheen roughness to [1e-3, 1] and drops the lobe where the interpolated |a| or albedo is
 below 1e-5 (``CUTOFF``); so do we.  Since the density is invariant under a uniform scale of Minv, the

@@ -2,10 +2,10 @@
 
     python scripts/benchmark_environment.py [--normals 500] [--dirs 128] [--out docs/benchmarks/environment.md]
 
-Entry point of ``rt_lookdev.validation.environment_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.environment_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import environment_benchmark
+from rt_lookdev.validation.benchmarks import environment_benchmark
 
 
 def main(argv):

@@ -3,10 +3,10 @@ on the demo scene and a 16-light scene.
 
     python scripts/benchmark_light_culling.py [--out docs/benchmarks] [--repeats 3] [--quick] [--scenes demo,grid]
 
-Entry point of ``rt_lookdev.validation.light_culling_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.light_culling_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import light_culling_benchmark
+from rt_lookdev.validation.benchmarks import light_culling_benchmark
 
 
 def main(argv):

@@ -3,10 +3,10 @@ controls (range, cone, fallback) cost per light.
 
     python scripts/benchmark_light_fallback.py [--out docs/benchmarks] [--quick]
 
-Entry point of ``rt_lookdev.validation.light_fallback_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.light_fallback_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import light_fallback_benchmark
+from rt_lookdev.validation.benchmarks import light_fallback_benchmark
 
 
 def main(argv):

@@ -2,10 +2,10 @@
 
     python scripts/benchmark_light_sync.py [--objects 100] [--lights 10] [--repeats 200]
 
-Entry point of ``rt_lookdev.validation.light_sync_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.light_sync_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import light_sync_benchmark
+from rt_lookdev.validation.benchmarks import light_sync_benchmark
 
 
 def main(argv):

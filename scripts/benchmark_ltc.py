@@ -4,10 +4,10 @@ error on random quad and disk lights, with the published GGX table through the s
     python scripts/benchmark_ltc.py [--out docs/benchmarks] [--repeats 3] [--quick]
                                     [--lut-dir DIR] [--skip-bake]
 
-Entry point of ``rt_lookdev.validation.ltc_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.ltc_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import ltc_benchmark
+from rt_lookdev.validation.benchmarks import ltc_benchmark
 
 
 def main(argv):

@@ -3,10 +3,10 @@ tables against those of an earlier revision.
 
     python scripts/benchmark_ltc_suite_like.py [--out docs/benchmarks] [--before REV] [--lut-dir DIR]
 
-Entry point of ``rt_lookdev.validation.ltc_suite_like``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.ltc_suite_like``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import ltc_suite_like
+from rt_lookdev.validation.benchmarks import ltc_suite_like
 
 
 def main(argv):

@@ -3,10 +3,10 @@ docs/benchmarks/lut_export.{md,json}.
 
     python scripts/benchmark_lut_export.py [--quads 120 --disks 60] [--out docs/benchmarks/lut_export.md]
 
-Entry point of ``rt_lookdev.validation.lut_export_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.lut_export_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import lut_export_benchmark
+from rt_lookdev.validation.benchmarks import lut_export_benchmark
 
 
 def main(argv):

@@ -2,10 +2,10 @@
 
     python scripts/benchmark_luts.py [--out docs/benchmarks] [--repeats 3] [--quick]
 
-Entry point of ``rt_lookdev.validation.lut_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.lut_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import lut_benchmark
+from rt_lookdev.validation.benchmarks import lut_benchmark
 
 
 def main(argv):

@@ -3,10 +3,10 @@ one mixed F0 and with the two F0 apart.
 
     python scripts/benchmark_metal_split.py [--out docs/benchmarks] [--quick]
 
-Entry point of ``rt_lookdev.validation.metal_split_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.metal_split_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import metal_split_benchmark
+from rt_lookdev.validation.benchmarks import metal_split_benchmark
 
 
 def main(argv):

@@ -4,10 +4,10 @@ docs/benchmarks/realtime.{md,json}.
     python scripts/benchmark_realtime.py [--width 1920 --height 1080] [--frames 5] [--lights 1,4,16]
                                          [--quick] [--device-label "GPU name"]
 
-Entry point of ``rt_lookdev.validation.realtime_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.realtime_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import realtime_benchmark
+from rt_lookdev.validation.benchmarks import realtime_benchmark
 
 
 def main(argv):

@@ -2,10 +2,10 @@
 
     python scripts/benchmark_rt_lit.py [--out docs/benchmarks] [--repeats 3] [--only LABEL]
 
-Entry point of ``rt_lookdev.validation.rt_lit_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.rt_lit_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import rt_lit_benchmark
+from rt_lookdev.validation.benchmarks import rt_lit_benchmark
 
 
 def main(argv):

@@ -2,10 +2,10 @@
 
     python scripts/benchmark_speed_error.py [--quick] [--out docs/benchmarks] [--cases NAME ...]
 
-Entry point of ``rt_lookdev.validation.speed_error``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.speed_error``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import speed_error
+from rt_lookdev.validation.benchmarks import speed_error
 
 
 def main(argv):

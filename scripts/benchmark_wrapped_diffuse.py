@@ -3,10 +3,10 @@ form and the talk's tilted normal), the World term's SH form.
 
     python scripts/benchmark_wrapped_diffuse.py [--out docs/benchmarks] [--lights 120] [--quick]
 
-Entry point of ``rt_lookdev.validation.wrapped_diffuse_benchmark``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.benchmarks.wrapped_diffuse_benchmark``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import wrapped_diffuse_benchmark
+from rt_lookdev.validation.benchmarks import wrapped_diffuse_benchmark
 
 
 def main(argv):

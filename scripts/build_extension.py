@@ -3,10 +3,10 @@
     python scripts/build_extension.py                 # -> dist/rt_lookdev-<version>.zip
     python scripts/build_extension.py --output-dir /tmp/out
 
-Entry point of ``rt_lookdev.validation.extension_zip``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.tools.extension_zip``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import extension_zip
+from rt_lookdev.validation.tools import extension_zip
 
 
 def main(argv):

@@ -3,10 +3,10 @@ technique, light kind and roughness, pooled over the cases both rendered.
 
     python scripts/compare_validation.py BEFORE_DIR AFTER_DIR [--techniques ggx turquin ...] [--out FILE.md]
 
-Entry point of ``rt_lookdev.validation.suite_compare``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.suite_compare``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import suite_compare
+from rt_lookdev.validation.checks import suite_compare
 
 
 def main(argv):

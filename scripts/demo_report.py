@@ -3,10 +3,10 @@
     python scripts/demo_report.py [--out out/report/demo] [--lut-dir DIR] [--resolution 256]
                                   [--repeats 3] [--skip-eevee]
 
-Entry point of ``rt_lookdev.validation.demo_measure``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.demo_measure``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import demo_measure
+from rt_lookdev.validation.checks import demo_measure
 
 
 def main(argv):

@@ -6,7 +6,7 @@
 them (the moments of each cell's LTC for the world term), without Cycles' renders.
 
 The table cannot be baked by numpy (it is the paper's fit, as Cycles ships it); scripts/bake_luts.py keeps
-it.  validation/sheen_table.py says how it is measured.
+it.  validation/benchmarks/sheen_table.py says how it is measured.
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from rt_lookdev.core.lut import catalog, exr_io
-from rt_lookdev.validation import sheen_table
+from rt_lookdev.validation.benchmarks import sheen_table
 
 
 def main(argv=None):

@@ -3,10 +3,10 @@ backend (numpy float32, GLSL, Cycles node groups); writes docs/benchmarks/robust
 
     python scripts/robustness_sweep.py [--points 200000] [--image-points N] [--backends numpy,glsl,cycles]
 
-Entry point of ``rt_lookdev.validation.robustness``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.robustness``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import robustness
+from rt_lookdev.validation.checks import robustness
 
 
 def main(argv):

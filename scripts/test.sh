@@ -91,6 +91,6 @@ done
 (
     export RTL_LOCK="$(lock_of "")"
     source "$repo/scripts/env.sh" >/dev/null || exit $?
-    python -m rt_lookdev.validation.version_matrix "$out"
+    python -m rt_lookdev.validation.tools.version_matrix "$out"
 ) || status=1
 exit $status

@@ -1,9 +1,9 @@
 """Headless validation of the RT Lit material (issue 5): node render vs numpy vs ground truth.
 
-Entry point of ``rt_lookdev.validation.suite``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.suite``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import suite
+from rt_lookdev.validation.checks import suite
 
 
 def main(argv):

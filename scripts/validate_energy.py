@@ -4,17 +4,15 @@
                                       [--out DIR] [--lut-dir DIR]
     blender --background --python scripts/validate_energy.py -- [same options]
 
-Entry point of ``rt_lookdev.validation.energy_render``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.energy_render``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import energy_render
+from rt_lookdev.validation.checks import energy_render
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    if "--" in argv:                      # blender --background --python x.py -- args
-        argv = argv[argv.index("--") + 1:]
-    args = energy_render.parse_args(argv)
-    return 0 if energy_render.run_args(args)["passed"] else 1
+    return entry.main(energy_render, argv, progress=print)
 
 
 if __name__ == "__main__":

@@ -5,17 +5,15 @@ candidate models (Lambert, Fujii's Oren-Nayar, EON, Cycles' variant).
     .venvs/blender-4.5/bin/python scripts/validate_rough_diffuse.py [same options]   (Blender 4.5's Cycles; the
                                                      venv is built by bash scripts/test.sh --release 4.5)
 
-Entry point of ``rt_lookdev.validation.rough_diffuse_furnace``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.rough_diffuse_furnace``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import rough_diffuse_furnace
+from rt_lookdev.validation.checks import rough_diffuse_furnace
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    if "--" in argv:                      # blender --background --python x.py -- args
-        argv = argv[argv.index("--") + 1:]
-    res = rough_diffuse_furnace.run_args(rough_diffuse_furnace.parse_args(argv))
-    return 0 if all("cycles" in c["best"] for c in res["cases"]) else 1
+    return entry.main(rough_diffuse_furnace, argv, progress=print)
 
 
 if __name__ == "__main__":

@@ -1,9 +1,9 @@
 """Headless validation of the RT Lit World term (issue 6) under Blender's studio HDRIs.
 
-Entry point of ``rt_lookdev.validation.world_suite``; ``--help`` lists the options."""
+Entry point of ``rt_lookdev.validation.checks.world_suite``; ``--help`` lists the options."""
 import sys
 
-from rt_lookdev.validation import world_suite
+from rt_lookdev.validation.checks import world_suite
 
 
 def main(argv):

@@ -5,18 +5,15 @@ It sits above the add-on (it drives the bpy layer to build scenes) and below ``s
 command-line entry points) and ``tests/``.  Import it as ``rt_lookdev.validation``: ``scripts/env.sh``
 installs the checkout in editable mode (pyproject.toml), so no ``sys.path`` edits are needed.
 
-- ``render_setup``     the Cycles and EEVEE measurement settings (no bounces, no filter, exact pixels)
-- ``engines``          render with Cycles / EEVEE to EXR passes and compare per pixel
-- ``conformance``      node groups vs the numpy backend on input grids (tests/blender)
-- ``suite_cases``      the validation suite's cases, scenes, numpy evaluation, ground truth and metrics
-- ``suite``            the validation suite: runs every case, gates, writes the report
-- ``world_cases``      the world validation's scenes, closures and brute-force references
-- ``world_suite``      the world validation: runs every studio HDRI, gates, writes the report
-- ``energy_render``    the Cycles white-furnace render check of the GGX energy tables
-- ``demo_measure``     the demo scene measured: node counts, Cycles time, EEVEE vs Cycles
-- ``main_job``         the main job (``scripts/main.sh``): every step and the report
-- ``*_benchmark``      the benchmarks writing docs/benchmarks/
-- ``report``, ``png``  EXR / PNG / CSV / HTML output
-- ``published_ltc``    the published GGX LTC table of selfshadow/ltc_code (comparison only, not shipped)
-- ``extension_zip``    validate the manifest and build the extension zip with Blender's tool
+Four layers, each importing only those before it (tests/core/test_layers.py; docs/architecture.md, "The
+validation package"):
+
+- ``harness``     the library: scenes and sphere meshes, measurement settings, renders and pass reading, the
+                  ground truth's closures, metrics, image I/O, the GL runner, outputs, the entry signature
+- ``checks``      gated comparisons with a truth: the suite, the world suite, energy, the rough-diffuse
+                  furnace, the lookdev twin, robustness, the demo
+- ``benchmarks``  the writers of docs/benchmarks/
+- ``main_job``    the main job (``scripts/main.sh``): every step and the report
+
+and beside them ``tools`` (the extension zip, the release matrix), which none of them imports.
 """

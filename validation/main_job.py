@@ -1,7 +1,10 @@
 """RT Lookdev main job: bake the LUTs if needed, validate them, write the report.
 
-    python scripts/run_main.py [--out out/report] [--lut-dir DIR] [--skip-render]
+    python scripts/run_main.py [--full] [--out out/report] [--lut-dir DIR] [--skip-render]
                                [--render-resolution N] [--render-samples S]
+
+By default the validation suite and the world validation run in their quick forms (minutes); --full runs them
+whole (about 20-30 minutes on 2 cores).
 
 Steps (each prints what it does):
 1. LUTs: bake the groups whose files are missing, stale or corrupt (cached otherwise).
@@ -17,7 +20,7 @@ Steps (each prints what it does):
    quad and a disk light, saved to <out>/demo/lookdev_demo.blend; node counts, Cycles render time,
    one EEVEE render compared with Cycles; the scene exported (<out>/demo/realtime_scene) and drawn by
    the GLSL backend's standalone renderer, compared with Cycles.
-7. The lookdev scene of "New Lookdev Scene" against its path-traced twin (validation/lookdev_twin.py):
+7. The lookdev scene of "New Lookdev Scene" against its path-traced twin (validation/checks/lookdev_twin.py):
    RT Lit in Cycles vs Cycles path tracing of the Principled twin, with and without the spheres'
    shadows, and EEVEE vs Cycles; <out>/lookdev/ and the pictures of docs/images/lookdev_*.png.
 8. Real-time backend, quick benchmark (scripts/benchmark_realtime.py --quick): frame time of the
@@ -45,13 +48,25 @@ from pathlib import Path
 
 import numpy as np
 
-from . import report
+from .harness import entry
 
 
 from ..core import multiscatter
 from ..core import energy_checks as validation  # noqa: E402
 from ..core import lut_bake as bake
 from ..core.lut import catalog, lookup  # noqa: E402
+from ..core.export import luts as lut_export
+from .benchmarks import ltc_benchmark as benchmark_ltc
+from .benchmarks import ltc_random_lights
+from .benchmarks import realtime_benchmark
+from .benchmarks import speed_error
+from .checks import demo_measure as demo_report
+from .checks import energy_render as validate_energy
+from .checks import lookdev_twin
+from .checks import robustness
+from .checks import suite
+from .checks import world_suite
+from .harness import glsl_runner
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -64,7 +79,7 @@ LTC_MEDIAN_TOL = {"ggx": 0.015, "cod_diffuse": 0.01, "cloth": 0.01}   # quads, l
 LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main job
 
 
-def step_luts(lut_dir, log=report.flush_log):
+def step_luts(lut_dir, log=entry.flush_log):
     log(f"[1/13] LUTs in {lut_dir}")
 
     def progress(group, done, total):
@@ -78,7 +93,7 @@ def step_luts(lut_dir, log=report.flush_log):
             "passed": all(s.state == "ok" for s in status)}
 
 
-def step_numpy_checks(lut_dir, log=report.flush_log):
+def step_numpy_checks(lut_dir, log=entry.flush_log):
     log("[2/13] numpy energy checks")
     t0 = time.perf_counter()
     tables = lookup.LutSet.from_folder(lut_dir)
@@ -109,18 +124,16 @@ def step_numpy_checks(lut_dir, log=report.flush_log):
     return out
 
 
-def step_demo(out_dir, lut_dir, eevee=True, log=report.flush_log):
+def step_demo(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[6/13] demo lookdev scene: build, node counts, Cycles, EEVEE and GLSL renders")
-    from . import demo_measure as demo_report
 
     result = demo_report.run(out_dir / "demo", lut_dir=lut_dir, eevee=eevee, log=log)
     result["summary_markdown"] = demo_report.format_markdown(result, image_prefix="demo/")
     return result
 
 
-def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
+def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[7/13] lookdev scene (New Lookdev Scene) vs its path-traced twin, Cycles and EEVEE")
-    from . import lookdev_twin
 
     result = lookdev_twin.run(out_dir / "lookdev", lut_dir=lut_dir, eevee=eevee, pictures_dir=REPO / "docs" / "images",
                               log=log)
@@ -130,9 +143,8 @@ def step_lookdev_twin(out_dir, lut_dir, eevee=True, log=report.flush_log):
     return result
 
 
-def step_lut_export(out_dir, lut_dir, log=report.flush_log):
+def step_lut_export(out_dir, lut_dir, log=entry.flush_log):
     log("[4/13] LUT export for engines: every format and precision, both layouts, read back (scripts/export_luts.py)")
-    from ..core.export import luts as lut_export
 
     t0 = time.perf_counter()
     out = {"layouts": {}}
@@ -160,10 +172,9 @@ def step_lut_export(out_dir, lut_dir, log=report.flush_log):
     return out
 
 
-def step_robustness(out_dir, lut_dir, log=report.flush_log):
+def step_robustness(out_dir, lut_dir, log=entry.flush_log):
     log("[11/13] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
         "(scripts/robustness_sweep.py --points 2000)")
-    from . import robustness
 
     out = out_dir / "benchmarks" / "robustness.md"
     argv = ["--points", "2000", "--out", str(out)] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
@@ -182,10 +193,9 @@ def step_robustness(out_dir, lut_dir, log=report.flush_log):
             "passed": result["failures"] == 0, "summary_markdown": text}
 
 
-def step_speed_error(out_dir, lut_dir, eevee=True, log=report.flush_log):
+def step_speed_error(out_dir, lut_dir, eevee=True, log=entry.flush_log):
     log("[12/13] speed vs error, quick: RT Lit's backends against path tracing at equal error "
         "(scripts/benchmark_speed_error.py --quick)")
-    from . import speed_error
 
     folder = out_dir / "benchmarks" / "speed_error"
     cache = out_dir / "validation_world" / "env_cache"           # the world validation's bakes, when there
@@ -200,9 +210,8 @@ def step_speed_error(out_dir, lut_dir, eevee=True, log=report.flush_log):
             "seconds": result["seconds"], "summary_markdown": text}
 
 
-def step_realtime_benchmark(out_dir, log=report.flush_log):
+def step_realtime_benchmark(out_dir, log=entry.flush_log):
     log("[8/13] real-time backend: frame time of the emitted material, quick (scripts/benchmark_realtime.py --quick)")
-    from . import glsl_runner, realtime_benchmark
 
     glsl_runner.disable_shader_cache()
     ok, why = glsl_runner.available()
@@ -217,9 +226,10 @@ def step_realtime_benchmark(out_dir, log=report.flush_log):
             "lights): docs/benchmarks/realtime.md (`python scripts/benchmark_realtime.py`)."}
 
 
-def _run_suite(module, folder, lut_dir, log):
-    """Run a validation module (``suite`` or ``world_suite``) into ``folder``: (result, checks table)."""
-    argv = ["--out", str(folder)] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
+def _run_suite(module, folder, lut_dir, log, full=False):
+    """Run a validation module (``suite`` or ``world_suite``) into ``folder``, its quick form unless ``full``:
+    (result, checks table)."""
+    argv = ["--out", str(folder)] + (["--lut-dir", str(lut_dir)] if lut_dir else []) + ([] if full else ["--quick"])
     result = module.run(module.parse_args(argv), log=lambda line: log("      " + line))
     lines = ["| check | measured | threshold | |", "|---|---|---|---|"]
     lines += [f"| {c['name']} | {c['measured']} | {c['threshold']} | {'ok' if c['ok'] else '**FAIL**'} |"
@@ -227,43 +237,41 @@ def _run_suite(module, folder, lut_dir, log):
     return result, lines
 
 
-def step_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[9/13] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py)")
-    from . import suite
+def step_validation(out_dir, lut_dir, log=entry.flush_log, full=False):
+    log("[9/13] validation suite: node render vs numpy vs Cycles ground truth (scripts/validate.py"
+        + ("" if full else " --quick") + ")")
 
-    result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log)
+    result, lines = _run_suite(suite, out_dir / "validation", lut_dir, log, full)
     return {"passed": bool(result["passed"]), "checks": result["checks"],
             "summary_markdown": "\n".join(lines) + f"\n\nFull report: `{out_dir / 'validation' / 'report.html'}`."}
 
 
-def step_world_validation(out_dir, lut_dir, log=report.flush_log):
-    log("[10/13] world validation: the World term under the studio HDRIs (scripts/validate_world.py)")
-    from . import world_suite
+def step_world_validation(out_dir, lut_dir, log=entry.flush_log, full=False):
+    log("[10/13] world validation: the World term under the studio HDRIs (scripts/validate_world.py"
+        + ("" if full else " --quick") + ")")
 
-    result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log)
+    result, lines = _run_suite(world_suite, out_dir / "validation_world", lut_dir, log, full)
     report_md = out_dir / "validation_world" / "report.md"
     return {"passed": bool(result["passed"]), "checks": result["checks"],
             "summary_markdown": "\n".join(lines) + f"\n\nFull report (per HDRI and roughness): `{report_md}`."}
 
 
-def step_render(out_dir, lut_dir, resolution, samples, log=report.flush_log):
+def step_render(out_dir, lut_dir, resolution, samples, log=entry.flush_log):
     log("[5/13] Cycles white-furnace render check (4 roughness values, 2 distributions, 2 seeds)")
-    from . import energy_render as validate_energy
 
     options = {k: v for k, v in (("resolution", resolution), ("samples", samples)) if v is not None}
-    result = validate_energy.run(out_dir=out_dir / "energy_render", lut_dir=lut_dir,
+    result = validate_energy.measure(out_dir=out_dir / "energy_render", lut_dir=lut_dir,
                                  log=lambda line: log("      " + line), **options)
-    result["summary_markdown"] = "```\n" + validate_energy.format_table(result) + "\n```"
+    result["summary_markdown"] = validate_energy.to_markdown(result)
     return result
 
 
-def step_ltc(lut_dir, log=report.flush_log):
+def step_ltc(lut_dir, log=entry.flush_log):
     log("[3/13] LTC area lights: random quads and disks vs brute force")
-    from . import ltc_benchmark as benchmark_ltc
 
     t0 = time.perf_counter()
     tables = {name: benchmark_ltc.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}
-    results = benchmark_ltc.end_to_end(tables, None, *LTC_LIGHTS)
+    results = ltc_random_lights.end_to_end(tables, None, *LTC_LIGHTS)
     out = {"lights_per_brdf": {"quads": LTC_LIGHTS[0], "disks": LTC_LIGHTS[1]}, "results": results,
            "seconds": round(time.perf_counter() - t0, 1)}
     out["passed"] = all(results[f"{lobe}/quad"]["ours"]["rel_median"] <= tol for lobe, tol in LTC_MEDIAN_TOL.items())
@@ -276,7 +284,10 @@ def write_report(job, out_dir):
     n = job["numpy_checks"]
     c = n["cycles_table"]
     lines = ["# RT Lookdev report", "",
-             f"Generated by `bash scripts/main.sh` on {job['date']} in {job['seconds']:.0f} s.", "",
+             f"Generated by `bash scripts/main.sh{' --full' if job.get('mode') == 'full' else ''}` on {job['date']} "
+             f"in {job['seconds']:.0f} s: the "
+             + ("whole validation suite and world validation." if job.get("mode") == "full" else
+                "quick forms of the validation suite and the world validation (`--full` runs them whole)."), "",
              "## LUTs", ""]
     lines += [f"- `{name}`: {state}" for name, state in job["luts"]["status"].items()]
     lines += ["- bake: " + ", ".join(f"{r['group']} {r['state']} ({r['seconds']} s)" for r in job["luts"]["records"]),
@@ -341,6 +352,9 @@ def write_report(job, out_dir):
     speed = job.get("speed_error")
     lines += ["## Speed vs error (quick): equal-error speedup over path tracing", ""]
     lines += [speed["summary_markdown"], ""] if speed else ["Skipped (--skip-render).", ""]
+    if job.get("step_seconds"):
+        lines += ["## Time per step", "", "| step | seconds |", "|---|---|"]
+        lines += [f"| {key} | {seconds:.1f} |" for key, seconds in job["step_seconds"].items()] + [""]
     lines += [f"Overall: **{'PASS' if job['passed'] else 'FAIL'}**", ""]
     (out_dir / "report.md").write_text("\n".join(lines))
 
@@ -354,6 +368,9 @@ def parse_args(argv):
     p.add_argument("--skip-eevee", action="store_true", help="demo scene: skip the EEVEE render")
     p.add_argument("--render-resolution", type=int, default=None, help="pixels per sphere")
     p.add_argument("--render-samples", type=int, default=None, help="Cycles samples per pixel")
+    p.add_argument("--full", action="store_true",
+                   help="the whole validation suite and world validation (about 20-30 minutes on 2 cores) instead "
+                        "of their quick forms (the default: minutes)")
     return p.parse_args(argv)
 
 
@@ -365,32 +382,47 @@ def _passed(job):
                                   "world_validation", "robustness", "speed_error")))
 
 
-def run(args, log=report.flush_log):
+#: The Cycles render check's (pixels per sphere, samples) in the quick main job (--full: the check's own defaults, 256
+#: and 256): its four renders took 197 s of a 1166 s quick run at full size (2026-12-03, 2 cores).
+QUICK_RENDER = (128, 64)
+
+
+def _timed(job, key, step, *args, **kwargs):
+    """``job[key] = step(*args, **kwargs)``, its wall time in ``job["step_seconds"][key]``."""
+    t0 = time.perf_counter()
+    job[key] = step(*args, **kwargs)
+    job.setdefault("step_seconds", {})[key] = round(time.perf_counter() - t0, 1)
+    return job[key]
+
+
+def run(args, log=entry.flush_log):
     """Every step, then the report (``args.out``/report.md, report.json).  Returns the report dict; when
     the LUTs are not usable, stops after step 1 with ``{"luts": ..., "passed": False}`` (no report)."""
     t0 = time.perf_counter()
-    job = {"date": time.strftime("%Y-%m-%d %H:%M:%S")}
-    job["luts"] = step_luts(args.lut_dir, log)
+    job = {"date": time.strftime("%Y-%m-%d %H:%M:%S"), "mode": "full" if args.full else "quick"}
+    _timed(job, "luts", step_luts, args.lut_dir, log)
     if not job["luts"]["passed"]:
         print("LUTs are not usable; see the status above", file=sys.stderr)
         job["passed"] = False
         return job
-    job["numpy_checks"] = step_numpy_checks(args.lut_dir, log)
-    job["ltc"] = step_ltc(args.lut_dir, log)
-    job["lut_export"] = step_lut_export(args.out, args.lut_dir, log)
+    _timed(job, "numpy_checks", step_numpy_checks, args.lut_dir, log)
+    _timed(job, "ltc", step_ltc, args.lut_dir, log)
+    _timed(job, "lut_export", step_lut_export, args.out, args.lut_dir, log)
     job["render"] = job["demo"] = job["lookdev_twin"] = job["validation"] = job["world_validation"] = None
     job["speed_error"] = None
+    quick_resolution, quick_samples = (None, None) if args.full else QUICK_RENDER
     if not args.skip_render:
-        job["render"] = step_render(args.out, args.lut_dir, args.render_resolution, args.render_samples, log)
-        job["demo"] = step_demo(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
-        job["lookdev_twin"] = step_lookdev_twin(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
-    job["realtime_benchmark"] = step_realtime_benchmark(args.out, log)
+        _timed(job, "render", step_render, args.out, args.lut_dir, args.render_resolution or quick_resolution,
+               args.render_samples or quick_samples, log)
+        _timed(job, "demo", step_demo, args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+        _timed(job, "lookdev_twin", step_lookdev_twin, args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+    _timed(job, "realtime_benchmark", step_realtime_benchmark, args.out, log)
     if not args.skip_render:
-        job["validation"] = step_validation(args.out, args.lut_dir, log)
-        job["world_validation"] = step_world_validation(args.out, args.lut_dir, log)
-    job["robustness"] = step_robustness(args.out, args.lut_dir, log)
+        _timed(job, "validation", step_validation, args.out, args.lut_dir, log, args.full)
+        _timed(job, "world_validation", step_world_validation, args.out, args.lut_dir, log, args.full)
+    _timed(job, "robustness", step_robustness, args.out, args.lut_dir, log)
     if not args.skip_render:
-        job["speed_error"] = step_speed_error(args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
+        _timed(job, "speed_error", step_speed_error, args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
     job["passed"] = _passed(job)
     job["seconds"] = time.perf_counter() - t0
     log("[13/13] report")

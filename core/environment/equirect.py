@@ -28,6 +28,7 @@ node: rotate then translate), so L_world(d) = strength * image(R_z(rotation_z) d
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,8 +39,6 @@ PI = np.pi
 
 def studio_lights_dir():
     """Blender's bundled studio HDRIs (CC0) inside the installed bpy wheel: ``datafiles/studiolights/world``."""
-    import importlib.util
-
     spec = importlib.util.find_spec("bpy")
     roots = []
     if spec is not None and spec.submodule_search_locations:

@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from .. import indirect
 from . import equirect
 
 PI = math.pi
@@ -39,8 +40,6 @@ LAMBERT_ZONAL = np.array([PI, 2.0 * PI / 3.0, PI / 4.0])
 def sh9_basis(d):
     """(..., 9) real SH basis at unit directions d (..., 3) (R&H 2001, eq. 3; d used as given): the
     traceable basis of core/indirect.py (the one the node groups evaluate), as an array."""
-    from .. import indirect
-
     return indirect.sh9_basis_array(d)
 
 
@@ -142,8 +141,6 @@ def wrapped_lobe_zonal(wrap):
     l = 2: int_{-w}^{1} (t + w)(3 t^2 - 1)/2 dt = (1 - w^2)^2 / 8.)  Lambda_0 = 1 for every w is the
     normalisation's energy conservation: a uniform white world gives 1, as Lambert's A_0 / pi.
     w = 0 gives A_l / pi = (1, 2/3, 1/4).  Checked against ``zonal_factors_quadrature``."""
-    from .. import indirect
-
     w = np.asarray(wrap, dtype=np.float64)
     return np.stack(np.broadcast_arrays(*indirect.wrapped_lobe_zonal(w)), axis=-1)   # one source
 

@@ -30,7 +30,9 @@ earlier export (a folder with this exporter's manifest and nothing else).
 from __future__ import annotations
 
 import argparse
+import io
 import json
+import re
 import sys
 import time
 from dataclasses import dataclass, field
@@ -38,9 +40,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..lut import catalog, exr_io, exr_writer
+from .. import lut_bake
+from ..lut import catalog, exr_io, exr_reader, exr_writer
 from ..lut.lookup import LutSet
-from . import containers
+from . import containers, lut_code
 from .folders import replacing_folder
 
 FORMATS = ("exr", "ktx2", "dds", "npz", "c", "glsl", "hlsl")
@@ -246,8 +249,6 @@ def _table_file(table, fmt, precision, layout, manifest_entry):
 
 
 def _npz_bytes(tables, precision, manifest):
-    import io
-
     arrays = {t.name: encode(t.data, precision)[0] for t in tables}
     arrays["manifest_json"] = np.frombuffer(json.dumps(manifest).encode(), np.uint8)
     buf = io.BytesIO()
@@ -284,8 +285,6 @@ def manifest(tables, layout, precisions, formats, generator_version):
 
 
 def _generator_version():
-    import re
-
     text = (Path(__file__).resolve().parents[2] / "blender_manifest.toml").read_text()
     m = re.search(r'^version\s*=\s*"([^"]+)"', text, re.M)
     return m.group(1) if m else "unknown"
@@ -298,8 +297,6 @@ def _check_sources(lut_dir, rebake, log):
     if not rebake:
         raise LutExportError("the source tables are not usable: " + "; ".join(s.message for s in bad)
                              + " (re-bake them, or export with --rebake)")
-    from .. import lut_bake
-
     (log or print)(f"export: re-baking {', '.join(s.name for s in bad)} in {lut_dir}")
     lut_bake.bake(lut_dir, log=log or print)
 
@@ -335,8 +332,6 @@ def export(out, lut_dir=None, formats=FORMATS, precisions=PRECISIONS, layout="rt
            log=None):
     """Export the LUTs of ``lut_dir`` (default: the shipped ones) into ``out``; returns an ExportResult.
     ``progress(done, total, what)`` is called as files are written."""
-    from . import lut_code
-
     formats, precisions = tuple(formats), tuple(precisions)
     for value, allowed, what in ((formats, FORMATS, "format"), (precisions, PRECISIONS, "precision")):
         unknown = [v for v in value if v not in allowed]
@@ -360,7 +355,8 @@ def export(out, lut_dir=None, formats=FORMATS, precisions=PRECISIONS, layout="rt
             elif fmt == "npz":
                 name, data = f"rtl_luts_{precision}.npz", _npz_bytes(tables, precision, info)
             else:
-                name, data = lut_code.source_file(tables, fmt, precision, layout, info)
+                stored = {t.name: encode(t.data, precision)[0] for t in tables}
+                name, data = lut_code.source_file(tables, fmt, precision, layout, info, stored)
             (tmp / name).write_bytes(data)
             sizes[name] = len(data)
             if progress:
@@ -401,8 +397,6 @@ def read_table_file(path):
     if path.suffix == ".dds":
         return containers.read_dds(data)
     if path.suffix == ".exr":
-        from ..lut import exr_reader
-
         attrs, planes = exr_reader.read(path)
         table = np.stack([planes[c] for c in "RGBA"], -1).astype(np.float32)
         return np.flipud(table) if attrs.get("rtl.layout") == "rtl" else table

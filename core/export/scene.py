@@ -28,6 +28,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..lights import split_kind
+from ..lut import catalog
+from ..lut.lookup import LutSet
+from ..materials import rt_lit
+from ..materials.rt_lit_interface import Features, LIGHT_KINDS
+from ..materials.world_shading import WorldEnvironment
 from .folders import replacing_folder
 
 FORMAT = "rt-lookdev-scene"
@@ -205,7 +211,6 @@ class SceneDescription:
         """The world's ``WorldEnvironment`` (None without a world)."""
         if self.world is None:
             return None
-        from ..materials.world_shading import WorldEnvironment
 
         path = self._path(TABLES_DIR, self.world.file)
         try:
@@ -215,9 +220,6 @@ class SceneDescription:
 
     def table_set(self):
         """The table set the materials read: the LUTs of tables/ (verified on first use) and the world's."""
-        from ..lut import catalog
-        from ..lut.lookup import LutSet
-
         folder = self._path(TABLES_DIR)
         luts = [name for name in self.tables if name in catalog.TABLES]
         for name in luts:
@@ -232,9 +234,6 @@ class SceneDescription:
     def build_materials(self):
         """{material name: core.materials.rt_lit.RtLitMaterial} traced for the scene's lights and world;
         each material's tables must be in the description."""
-        from ..materials import rt_lit
-        from ..materials.rt_lit_interface import Features
-
         env = self.environment()
         out = {}
         for name, mat in self.materials.items():
@@ -318,8 +317,6 @@ def read(folder):
     if data.get("version") != VERSION:
         raise SceneDescriptionError(f"{path}: version {data.get('version')} is not supported (this reader reads "
                                     f"version {VERSION}); export the scene again")
-    from ..lights import split_kind
-    from ..materials.rt_lit_interface import LIGHT_KINDS
 
     try:
         camera = Camera(**data["camera"])

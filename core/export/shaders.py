@@ -16,8 +16,13 @@ import json
 import shutil
 from pathlib import Path
 
+from ..lights import OPTION_KINDS, split_kind
 from ..lut import catalog
-from ..materials import rt_lit_shader
+from ..lut.exr_io import LutError
+from ..materials import rt_lit, rt_lit_shader
+from ..materials.rt_lit_interface import (DIFFUSE_MODELS, Features, LIGHT_KINDS, PRINCIPLED_SHEEN, SHEEN_MODELS,
+                                          SPECULAR_MODELS)
+from ..materials.world_shading import WorldEnvironment
 from .folders import replacing_folder
 
 EXTENSIONS = {"glsl450": ("glsl450.frag", "glsl450.vert"), "glsl300es": ("glsl300es.frag", "glsl300es.vert"),
@@ -77,8 +82,6 @@ def write_material_shaders(folder, material, dialects=tuple(EXTENSIONS), luts=No
 
 def _light_kinds(text):
     """--lights: the kinds in order ("quad,disk+cone+range"); a bad one is argparse's error, naming the valid ones."""
-    from ..lights import OPTION_KINDS, split_kind
-
     kinds = tuple(k for k in text.split(",") if k)
     for kind in kinds:
         try:
@@ -106,9 +109,6 @@ _WORLD_FILE = "a world bake's prefiltered EXR (<name>_ggx_prefiltered.exr of pyt
 
 def _world(parser, path, table):
     """The --world environment, or the parser's one-line error saying what is wrong with the file."""
-    from ..lut.exr_io import LutError
-    from ..materials.world_shading import WorldEnvironment
-
     if not path.is_file():
         parser.error(f"argument --world: {path} does not exist; it takes {_WORLD_FILE}")
     try:
@@ -120,9 +120,6 @@ def _world(parser, path, table):
 def parse_args(argv):
     """The options of scripts/export_shader.py, checked: a bad one ends in argparse's one-line error (exit code 2).
     ``environment``: the --world file loaded (a ``WorldEnvironment``), or None."""
-    from ..materials.rt_lit_interface import (DIFFUSE_MODELS, LIGHT_KINDS, PRINCIPLED_SHEEN, SHEEN_MODELS,
-                                              SPECULAR_MODELS)
-
     p = argparse.ArgumentParser(description="Write the RT Lit material's shaders, interface and tables for an engine")
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--specular", default="turquin", choices=SPECULAR_MODELS)
@@ -146,9 +143,6 @@ def parse_args(argv):
 
 def run_args(args, log=print):
     """scripts/export_shader.py: build the material the options name and write it; the exit code."""
-    from ..materials import rt_lit
-    from ..materials.rt_lit_interface import Features
-
     material = rt_lit.build_rt_lit(Features(args.specular, args.diffuse, args.sheen, args.cloth), args.lights,
                                    args.environment)
     written = write_material_shaders(args.out, material, args.dialects,

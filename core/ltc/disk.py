@@ -94,7 +94,7 @@ def negative_root(trace, s2, det):
     low = m2 * op.cos(phi3 + 2.0 * np.pi / 3.0) + third
     prod = op.safe_div(det * -1.0, high)
     s = op.safe_div(s2 - prod, high)
-    sign = polygon._sign(op.less(s, 0.0), s)
+    sign = polygon.unit_sign(op.less(s, 0.0), s)
     big = 0.5 * (s + sign * op.sqrt(s * s - 4.0 * prod))
     from_quadratic = op.minimum(big, op.safe_div(prod, big))
     return op.minimum(op.select(op.greater(high, -low), from_quadratic, low), 0.0)
@@ -106,7 +106,7 @@ def ellipse_form_factor(c, v1, v2):
     semi-diameters v1, v2 (vectors, arrays or Exprs) seen from the origin; the last one's sign
     tells the side the origin is on."""
     extent = op.length(c) + op.length(v1) + op.length(v2)
-    scale = op.safe_div(polygon._ones_like(extent), extent)
+    scale = op.safe_div(polygon.ones_like(extent), extent)
     c, v1, v2 = op.scale(c, scale), op.scale(v1, scale), op.scale(v2, scale)
     n = op.cross(v1, v2)
     a, b = op.cross(v2, c), op.cross(c, v1)
@@ -131,7 +131,7 @@ def ellipse_form_factor(c, v1, v2):
     cc = op.dot(c, c)
     near = op.less(cc * g, NEAR_PLANE * NEAR_PLANE * nn)
     n_len = op.sqrt(nn)
-    toward = op.scale(n, op.safe_div(polygon._sign(op.less(cn, 0.0), cn), n_len))
+    toward = op.scale(n, op.safe_div(polygon.unit_sign(op.less(cn, 0.0), cn), n_len))
     axis = op.vselect(near, toward, op.normalize(x))
     near_form_factor = op.safe_div(n_len, n_len + cc)
     return op.select(near, near_form_factor, form_factor), axis, cn

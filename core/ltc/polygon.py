@@ -63,7 +63,7 @@ EDGE_SIN2_MIN = 1e-30
 EDGE_ON_SIN = 1e-5
 
 
-def _vectors(points):
+def corner_vectors(points):
     """A polygon as a list of K vectors: sequences pass through, arrays (..., K, 3) are split."""
     if isinstance(points, (list, tuple)):
         return list(points)
@@ -76,12 +76,12 @@ def _sum(terms):
     return functools.reduce(operator.add, terms)
 
 
-def _ones_like(x):
+def ones_like(x):
     """1: a constant once traced, an array of x's shape and dtype in numpy."""
     return 1.0 if is_expr(x) else np.ones_like(x)
 
 
-def _sign(negative, like):
+def unit_sign(negative, like):
     """-1 where ``negative`` else +1: a Select node once traced, an array of ``like``'s dtype in numpy."""
     s = op.select(negative, -1.0, 1.0)
     return s if is_expr(s) else s.astype(np.result_type(np.asarray(like).dtype, np.float32))
@@ -93,8 +93,8 @@ def _sign(negative, like):
 # Basis, Revisited" (JCGT 6(1)): their branchless first basis vector, a unit tangent of n.
 def _any_tangent(n):
     nx, ny, nz = (op.component(n, i) for i in range(3))
-    s = _sign(op.less(nz, 0.0), nz)
-    a = -op.safe_div(_ones_like(nz), s + nz)  # |s + n.z| >= 1 for unit n
+    s = unit_sign(op.less(nz, 0.0), nz)
+    a = -op.safe_div(ones_like(nz), s + nz)  # |s + n.z| >= 1 for unit n
     return op.vec3(1.0 + s * nx * nx * a, s * nx * ny * a, -s * nx)
 
 
@@ -120,7 +120,7 @@ def to_local(points, p, n, v):
     (T1, T2, N) frame relative to p, and the view cosine N.V.  ``points`` is a sequence of vectors
     (returned as a list) or an array (..., K, 3) (returned as an array)."""
     frame = local_frame(n, v)
-    local = [frame_coordinates(frame, q - p) for q in _vectors(points)]
+    local = [frame_coordinates(frame, q - p) for q in corner_vectors(points)]
     if not isinstance(points, (list, tuple)):
         local = np.stack(local, axis=-2)
     return local, op.dot(frame[2], op.normalize(v))
@@ -191,7 +191,7 @@ def _next(points):
 def vector_form_factor(unit_points, exact=False):
     """F = sum over the closed polygon's edges of the edge vectors; unit_points: K unit vectors
     (a sequence, or an array (..., K, 3))."""
-    pts = _vectors(unit_points)
+    pts = corner_vectors(unit_points)
     nxt = pts[1:] + pts[:1]
     weight = edge_weight_exact if exact else edge_weight
     w = [weight(a, b) for a, b in zip(pts, nxt)]
@@ -206,7 +206,7 @@ def light_normal(points):
     """Newell's normal sum_i p_i x p_(i+1) (twice the vector area of a planar polygon), summed as
     sum_i (p_i - p_0) x (p_(i+1) - p_0) (the same, without cancellation for small lights); for a
     quad it is the cross product of the diagonals, (p2 - p0) x (p3 - p1) (the same sum expanded)."""
-    pts = _vectors(points)
+    pts = corner_vectors(points)
     if len(pts) == 4:
         return op.cross(pts[2] - pts[0], pts[3] - pts[1])
     d = [q - pts[0] for q in pts]
@@ -227,14 +227,14 @@ def _plane_point(pts, center):
 def behind(points, center=None):
     """True (1) where the origin lies behind the light (p . n < 0, ltc_code ``ltc_quad.fs``; p = ``center`` or
     the corners' mean where ltc_code takes p0)."""
-    pts = _vectors(points)
+    pts = corner_vectors(points)
     return op.less(op.dot(_plane_point(pts, center), light_normal(pts)), 0.0)
 
 
 def off_plane(points, center=None):
     """1 where the origin lies off the light's plane by more than ``EDGE_ON_SIN`` (measured from ``center`` or
     the corners' mean); 0 where the light is seen edge-on and gives 0."""
-    pts = _vectors(points)
+    pts = corner_vectors(points)
     normal = light_normal(pts)
     ref = _plane_point(pts, center)
     return beyond_plane(op.dot(ref, normal), EDGE_ON_SIN * op.length(ref) * op.length(normal))
@@ -288,8 +288,8 @@ def polygon_integral_clipless(transformed, two_sided, sphere_table=None, untrans
     ``sphere_table``: see ``sphere_table.clipped_sphere_integral`` (a Table when traced);
     ``untransformed``: the polygon before the transform, for the side tests (default: ``transformed``),
     ``center``: a point of its plane there (default: its corners' mean)."""
-    pts = _vectors(transformed)
-    plane = pts if untransformed is None else _vectors(untransformed)
+    pts = corner_vectors(transformed)
+    plane = pts if untransformed is None else corner_vectors(untransformed)
     f = vector_form_factor([op.normalize(q) for q in pts])
     length = op.length(f)
     z = op.safe_div(op.component(f, 2), length)
@@ -304,7 +304,7 @@ def ltc_polygon_integral_packed(c, corners, two_sided=False, sphere_table=None, 
     """Clipless integral of the LTC with packed entries c = (c0, c1, c2, c3) over the polygon
     ``corners`` (K vectors in the local frame, relative to the shading point; ``center``: the light's
     centre there, for the side tests); traceable."""
-    corners = _vectors(corners)
+    corners = corner_vectors(corners)
     return polygon_integral_clipless([matrix.transform_packed(c, q) for q in corners], two_sided, sphere_table,
                                      corners, center)
 
@@ -343,7 +343,7 @@ def ltc_polygon_vector_form_factor(minv, corners):
     """Vector form factor F of the transformed, unclipped polygon (fitted edges): F.z is the exact
     LTC integral when the transformed polygon lies above the horizon (used by tests)."""
     minv, corners = _as_float(minv, corners)
-    return vector_form_factor([op.normalize(q) for q in _vectors(transform(minv, corners))])
+    return vector_form_factor([op.normalize(q) for q in corner_vectors(transform(minv, corners))])
 
 
 # --- horizon clipping, traceable (exact for lobes that live near the horizon) --------------------
@@ -447,7 +447,7 @@ def clipped_form_factor_z(points):
     local frame, not normalised) clipped at z = 0: ``clip_to_horizon``'s closed sequence (every edge's part
     above the horizon, an edge entirely below collapsed onto the exit point), summed as ``vector_form_factor``
     does, one nested group per edge; traceable.  Negative seen from the polygon's back."""
-    pts = _vectors(points)
+    pts = corner_vectors(points)
     k = len(pts)
     edges = [_HORIZON_EDGE(A=pts[i], B=pts[(i + 1) % k]) for i in range(k)]
     exit_point = _sum([op.scale(e["Crossing"], e["Leaves"]) for e in edges])
@@ -483,8 +483,8 @@ def polygon_integral_horizon_clipped(transformed, two_sided, untransformed=None,
     """``polygon_integral_clipless`` with the exact horizon: the transformed quad clipped to z >= 0
     (``clipped_form_factor_z``), then the z of its vector form factor (Heitz et al. 2016, eq. 11); the same
     side and edge-on tests.  Any convex polygon (K corners, 2K clipped points)."""
-    pts = _vectors(transformed)
-    plane = pts if untransformed is None else _vectors(untransformed)
+    pts = corner_vectors(transformed)
+    plane = pts if untransformed is None else corner_vectors(untransformed)
     fz = clipped_form_factor_function(len(pts))(**{f"p{i}": q for i, q in enumerate(pts)})["Fz"]
     return clipped_side_value(fz, behind(plane, center), off_plane(plane, center), two_sided)
 

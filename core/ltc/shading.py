@@ -45,7 +45,7 @@ class QuadLight:
     center_point: object = None
 
     def corner_list(self):
-        corners = polygon._vectors(self.corners)
+        corners = polygon.corner_vectors(self.corners)
         if len(corners) != 4:
             raise ValueError("a quad light needs four corners")
         return corners

@@ -16,6 +16,7 @@ import ast
 import hashlib
 import io
 import json
+import shutil
 import tokenize
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -115,7 +116,7 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
                                 sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_prefix, ()))
 
 #: Cycles' sheen (Zeltner, Burley & Chiang 2022): the LTC (a, b) and albedo of each (mu, r), measured from
-#: Cycles renders (validation/sheen_table.py); 32 x 32 nodes at i/31 as Cycles' own table, so a bilinear
+#: Cycles renders (validation/benchmarks/sheen_table.py); 32 x 32 nodes at i/31 as Cycles' own table, so a bilinear
 #: lookup reproduces Cycles' exactly.  ``params`` say what was measured, with which Blender.
 ZELTNER_SHEEN_SIZE = 32
 #: Measured groups, apart from ``GROUPS`` (what ``core.lut_bake`` computes): ``keep_measured`` keeps them.
@@ -312,8 +313,6 @@ def keep_measured(lut_dir, log=print):
     """Measured tables are never computed by the bake (``core.lut_bake`` knows only ``GROUPS``): in
     ``lut_dir`` each is kept when current, else copied from the shipped folder when that one is intact;
     otherwise ``log`` says how to get it back.  Returns {group: "kept" | "copied" | "missing"}."""
-    import shutil
-
     out = {}
     shipped = default_lut_dir()
     for name, group in MEASURED_GROUPS.items():

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import exr_writer
+from . import exr_reader, exr_writer
 
 CHANNELS = ("R", "G", "B", "A")
 BAKE_COMMAND = "python scripts/bake_luts.py"
@@ -163,8 +163,6 @@ def _read_exr(path, with_pixels):
     try:
         import OpenEXR
     except ImportError:
-        from . import exr_reader
-
         return exr_reader.read(path)
     with OpenEXR.File(str(path), separate_channels=True, header_only=not with_pixels) as exr:
         header = {k: v for k, v in exr.header().items()}  # the dict is cleared on close

@@ -37,7 +37,8 @@ import numpy as np
 from .. import lights
 from ..ir import shader_text
 from ..ir.expr import FLOAT
-from .rt_lit_interface import LIGHT_KINDS, RT_LIT_INPUTS
+from . import rt_lit
+from .rt_lit_interface import Features, LIGHT_KINDS, RT_LIT_INPUTS
 
 #: Light parameters that are one vector uniform field: prefix -> (field, type, components in field order).
 _VECTOR_FIELDS = {
@@ -364,7 +365,4 @@ def interface_markdown(shader):
 
 def reference_material(environment):
     """The material docs/realtime.md documents: every technique on, one light of each kind, a world."""
-    from . import rt_lit
-    from .rt_lit_interface import Features
-
     return rt_lit.build_rt_lit(Features("kulla_conty", "wrapped", sheen=True, cloth=True), LIGHT_KINDS, environment)

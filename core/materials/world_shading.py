@@ -43,22 +43,21 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import json
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from pathlib import Path
-
-from .. import indirect, multiscatter, rough_diffuse, sheen
-from .. import shading_ops as op
+from .. import indirect, multiscatter, rough_diffuse, shading_ops as op, sheen
 from ..conventions import alpha_from_roughness
 from ..fresnel import fresnel_average
 from ..ir.functions import NodeFunction
 from ..ir.interface import Socket, color, factor, vector
 from ..ir.tables import Table
-from ..ltc import polygon
-from ..ltc import shading as ltc_shading
+from ..ltc import polygon, shading as ltc_shading
+from ..lut import exr_io
 from ..lut.lookup import REFERENCES
 from .light_shading import layer_sheen
 from .rt_lit_interface import SURFACE_OUTPUTS, world_input
@@ -97,10 +96,6 @@ class WorldEnvironment:
     def load(cls, prefiltered_path, name):
         """From a prefiltered EXR (``core.environment.prefilter``); exr_io's errors for an unreadable file,
         ValueError for another table."""
-        import json
-
-        from ..lut import exr_io
-
         table, meta = exr_io.read_table(prefiltered_path)
         if "roughness_levels" not in meta:
             raise ValueError(f"{prefiltered_path} holds the table {meta['table']!r}, not prefiltered levels "
@@ -307,7 +302,7 @@ def _rough_diffuse_multiscatter_world(coeffs, n, surface, ms_weight):
     return op.scale(op.vmul(color, lobe), ms_weight)
 # Zeltner 2022 sheen under the world (core/sheen.py): its exact integral against the L2 SH radiance.  L2 radiance
 # is a polynomial of degree 2 in the direction, so int L D = sum_i c_i E_D[Y_i] needs only D's first and second
-# moments (tables zeltner_sheen_sh1/2, computed per cell from the measured LTC: validation/sheen_table.py), taken
+# moments (tables zeltner_sheen_sh1/2, computed per cell from the measured LTC: validation/benchmarks/sheen_table.py), taken
 # from the local frame (T1, T2, N) to the world's here.  Against Cycles under two studio HDRIs (docs/sheen.md):
 # median 21% (studio, r = 0.5) and 7.9% (sunset, r = 0.2) where the talk's cosine lobe about the LTC's peak gave
 # 49% and 28%; what remains is the L2 truncation of the environment.

@@ -279,7 +279,7 @@ def test_lights_stay_in_sync_without_a_button(registered, empty_scene, lut_dir):
 
 def test_light_sync_benchmark_writes_its_report(bpy_module, tmp_path, lut_dir):
     """The README's `python scripts/benchmark_light_sync.py` (small here): report and JSON written."""
-    from rt_lookdev.validation import light_sync_benchmark
+    from rt_lookdev.validation.benchmarks import light_sync_benchmark
 
     out = tmp_path / "light_sync.md"
     result = light_sync_benchmark.run(light_sync_benchmark.parse_args(

@@ -25,7 +25,7 @@ def test_demo_scene_round_trips_and_reloads(empty_scene, lut_dir, tmp_path):
 
     from rt_lookdev.addon import convert
     from rt_lookdev.addon import demo_scene as build_demo_scene
-    from rt_lookdev.validation.engines import render_cycles_passes, render_reloaded
+    from rt_lookdev.validation.harness.engines import render_cycles_passes, render_reloaded
 
     spheres = build_demo_scene.build_demo_scene(lut_dir, resolution=80)
     scene = bpy.context.scene

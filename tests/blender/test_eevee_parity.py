@@ -18,7 +18,7 @@ import pytest
 
 pytest.importorskip("OpenEXR")
 
-from rt_lookdev.validation.engines import compare, eevee_available, render_engines  # noqa: E402
+from rt_lookdev.validation.harness.engines import compare, eevee_available, render_engines  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -175,9 +175,9 @@ def test_rt_lit_lobes_compute_the_same_in_eevee(empty_scene, tables, kind, lobe)
     ok, why = eevee_available()
     if not ok:
         pytest.skip(why)
-    from rt_lookdev.validation.conformance import render_group_outputs
-    from rt_lookdev.validation.grids import area_lobe_inputs as _area_inputs
-    from rt_lookdev.validation.grids import punctual_lobe_inputs as _punctual_inputs
+    from rt_lookdev.validation.harness.conformance import render_group_outputs
+    from rt_lookdev.validation.harness.grids import area_lobe_inputs as _area_inputs
+    from rt_lookdev.validation.harness.grids import punctual_lobe_inputs as _punctual_inputs
 
     from rt_lookdev.addon.node_emit import ensure_function_group
     from rt_lookdev.core.materials import lobes

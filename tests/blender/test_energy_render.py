@@ -14,7 +14,7 @@ import pytest
 
 pytest.importorskip("OpenEXR")
 
-from rt_lookdev.validation import energy_render as ve  # noqa: E402
+from rt_lookdev.validation.checks import energy_render as ve  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -26,7 +26,7 @@ SAMPLES = 128          # per-bin standard errors 1e-4 .. 6e-4 (GGX), far inside 
 @pytest.fixture(scope="module")
 def validation(bpy_module, lut_dir, tmp_path_factory):
     out = tmp_path_factory.mktemp("energy_render")
-    res = ve.run(resolution=RESOLUTION, samples=SAMPLES, roughness=ROUGHNESS, out_dir=out,
+    res = ve.measure(resolution=RESOLUTION, samples=SAMPLES, roughness=ROUGHNESS, out_dir=out,
                  lut_dir=lut_dir, exact=False, keep_exr=False, log=lambda *a: None)
     print(ve.format_table(res))
     return res, out

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rt_lookdev.validation.conformance import check_function
-from rt_lookdev.validation.grids import area_lobe_inputs as _area_inputs
-from rt_lookdev.validation.grids import shade_inputs
+from rt_lookdev.validation.harness.conformance import check_function
+from rt_lookdev.validation.harness.grids import area_lobe_inputs as _area_inputs
+from rt_lookdev.validation.harness.grids import shade_inputs
 
 pytest.importorskip("OpenEXR")
 
@@ -80,7 +80,7 @@ def test_materials_route_each_engine_to_its_tree_and_back(empty_scene, lut_dir):
     from rt_lookdev.addon import compat, convert, materials
     from rt_lookdev.addon.node_emit import flat_tree_node_count
     from rt_lookdev.core.materials.rt_lit_interface import Features
-    from rt_lookdev.validation import lit_scene
+    from rt_lookdev.validation.harness import lit_scene
 
     scene = lit_scene.build([("a", Features("turquin", "cod"))], kinds=("quad", "disk"), lut_dir=lut_dir)
     mat = bpy.data.materials["a"]
@@ -115,10 +115,10 @@ def test_materials_route_each_engine_to_its_tree_and_back(empty_scene, lut_dir):
 def test_cycles_and_eevee_trees_render_the_same_material(empty_scene, lut_dir):
     """Each engine renders its own tree (Cycles' against numpy: tests/blender/test_rt_lit_scene.py); EEVEE's
     matches Cycles' within the demo report's gates for EEVEE's half-precision film and rasterisation
-    (validation/demo_measure.py: median 2e-3, p99 3e-2; measured here 6e-4 and 1.2e-2 on llvmpipe)."""
+    (validation/checks/demo_measure.py: median 2e-3, p99 3e-2; measured here 6e-4 and 1.2e-2 on llvmpipe)."""
     from rt_lookdev.core.materials.rt_lit_interface import Features
-    from rt_lookdev.validation import engines, lit_scene
-    from rt_lookdev.validation.demo_measure import EEVEE_MEDIAN_TOL, EEVEE_P99_TOL
+    from rt_lookdev.validation.harness import engines, lit_scene
+    from rt_lookdev.validation.checks.demo_measure import EEVEE_MEDIAN_TOL, EEVEE_P99_TOL
 
     ok, why = engines.eevee_available()
     if not ok:
@@ -134,7 +134,7 @@ def test_cycles_and_eevee_trees_render_the_same_material(empty_scene, lut_dir):
 def test_a_material_without_specular_renders_like_numpy(empty_scene, lut_dir, tables):
     """Features(specular="none") through the whole bpy path: the group builds, Cycles renders it as numpy."""
     from rt_lookdev.core.materials.rt_lit_interface import Features
-    from rt_lookdev.validation import engines, lit_scene
+    from rt_lookdev.validation.harness import engines, lit_scene
 
     scene = lit_scene.build([("diffuse only", Features("none", "cod", sheen=True))], kinds=("quad", "point"),
                             lut_dir=lut_dir)

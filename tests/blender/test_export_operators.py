@@ -33,7 +33,7 @@ def test_export_scene_operator(registered, empty_scene, lut_dir, tmp_path):
     bpy = registered
     from rt_lookdev.core.export import scene as scene_io
     from rt_lookdev.core.materials.rt_lit_interface import Features
-    from rt_lookdev.validation import lit_scene
+    from rt_lookdev.validation.harness import lit_scene
 
     lit_scene.build([("typical", Features("turquin", "cod"))], kinds=("quad", "sun"), lut_dir=lut_dir)
     assert bpy.ops.rtl.export_scene(directory=str(tmp_path / "scene")) == {"FINISHED"}

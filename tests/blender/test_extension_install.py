@@ -7,7 +7,7 @@ from pathlib import Path, PurePosixPath
 
 import pytest
 
-from rt_lookdev.validation import extension_zip as build_extension
+from rt_lookdev.validation.tools import extension_zip as build_extension
 from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
@@ -125,7 +125,7 @@ def test_zip_check_rejects_development_files():
             "core/lut/catalog.py", "node_groups/__init__.py", "luts/e.exr", "assets/rt_lookdev_presets.blend",
             "assets/blender_assets.cats.txt"]
     build_extension.check_zip_contents(good, ["luts/e.exr"])
-    for extra in ("tests/conftest.py", "scripts/env.sh", "validation/suite.py", ".ci/run", "core/__pycache__/x.pyc"):
+    for extra in ("tests/conftest.py", "scripts/env.sh", "validation/checks/suite.py", ".ci/run", "core/__pycache__/x.pyc"):
         with pytest.raises(build_extension.BuildError, match="should not be shipped"):
             build_extension.check_zip_contents(good + [extra])
     with pytest.raises(build_extension.BuildError, match="missing LUT: luts/f.exr"):

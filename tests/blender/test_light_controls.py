@@ -19,7 +19,7 @@ FALLBACK = {"rtl_spot_fallback": True, "rtl_cone_inner": math.radians(100.0), "r
 
 
 def _case():
-    from rt_lookdev.validation import suite_cases as suite
+    from rt_lookdev.validation.checks import suite_cases as suite
 
     lights = [suite.LightSpec("quad", (1.5, -3.2, 1.6), 400.0, 1.6, 1.0, controls={**RANGE, **CONE}),
               suite.LightSpec("disk", (-2.5, -2.0, 1.0), 300.0, 1.0, controls=CONE),
@@ -31,14 +31,14 @@ def _case():
 
 
 def _passes_and_numpy(scene, case, tables):
-    from rt_lookdev.validation import suite_cases as suite
-    from rt_lookdev.validation.engines import render_cycles_passes
+    from rt_lookdev.validation.checks import suite_scene
+    from rt_lookdev.validation.harness.engines import render_cycles_passes
 
     res = (scene.render.resolution_x, scene.render.resolution_y)
     passes = render_cycles_passes(scene, res)
-    index = suite.sphere_index(case, passes["Position"], passes["Normal"])
+    index = suite_scene.sphere_index(case, passes["Position"], passes["Normal"])
     objects = [scene.objects[f"RTL_val_sphere_{i}"] for i in range(len(case.variants))]
-    b = suite.numpy_radiance(scene, case.variants, objects, passes, index, tables)
+    b = suite_scene.numpy_radiance(scene, case.variants, objects, passes, index, tables)
     return passes["Combined"].astype(np.float64), b, index >= 0
 
 
@@ -73,32 +73,34 @@ def test_controls_render_like_numpy_follow_edits_and_reload_without_python(empty
     import bpy
 
     from rt_lookdev.addon import materials
-    from rt_lookdev.validation import suite_cases as suite
-    from rt_lookdev.validation.engines import render_reloaded
+    from rt_lookdev.validation.checks import suite_cases as suite
+    from rt_lookdev.validation.checks import suite_metrics
+    from rt_lookdev.validation.checks import suite_scene
+    from rt_lookdev.validation.harness.engines import render_reloaded
 
     case = _case()
-    scene, _ = suite.build_scene(case, 40, 48, 24, lut_dir)
+    scene, _ = suite_scene.build_scene(case, 40, 48, 24, lut_dir)
     kinds = [kind for _, kind in materials.scene_lights(scene)]
     assert kinds == ["quad+cone+range", "disk+cone", "point+range", "quad_spot+range"]
     a, b, hit = _passes_and_numpy(scene, case, tables)
-    metrics = suite.ab_metrics(a, b, hit)
+    metrics = suite_metrics.ab_metrics(a, b, hit)
     print(f"controls: (a) vs (b) max rel {metrics['max_rel']:.2e}, max abs near 0 {metrics['max_abs_near_zero']:.2e}")
     assert metrics["finite"] and b[hit].max() > 0.1
     assert metrics["max_rel"] <= 1e-4 and metrics["max_abs_near_zero"] <= 1e-6
     # the falloffs do something: without them (the same lights plain) the image differs
     plain = [suite.LightSpec(s.kind, s.location, s.energy, s.size, s.size_y) for s in case.lights]
-    scene_plain, _ = suite.build_scene(suite.Case("plain", plain, case.variants, columns=3), 40, 48, 24, lut_dir)
+    scene_plain, _ = suite_scene.build_scene(suite.Case("plain", plain, case.variants, columns=3), 40, 48, 24, lut_dir)
     _, b_plain, _ = _passes_and_numpy(scene_plain, case, tables)
     assert np.abs(b_plain - b)[hit].max() > 0.05
 
-    scene, _ = suite.build_scene(case, 40, 48, 24, lut_dir)
+    scene, _ = suite_scene.build_scene(case, 40, 48, 24, lut_dir)
     # an edit of a driven control needs no sync: the drivers carry it
     bpy.data.lights["L0_quad"]["rtl_range"] = 3.0
     bpy.data.lights["L1_disk"]["rtl_cone_outer"] = math.radians(50.0)
     bpy.context.view_layer.update()
     a2, b2, _ = _passes_and_numpy(scene, case, tables)
     assert np.abs(b2 - b)[hit].max() > 0.05
-    assert suite.ab_metrics(a2, b2, hit)["max_rel"] <= 1e-4
+    assert suite_metrics.ab_metrics(a2, b2, hit)["max_rel"] <= 1e-4
     blend = tmp_path / "controls.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
     there, info = render_reloaded(blend, (scene.render.resolution_x, scene.render.resolution_y))

@@ -16,10 +16,10 @@ def _scene(bpy, lut_dir, ranged=True):
     a sun without one; an orthographic camera."""
     from rt_lookdev.addon import compat, materials
     from rt_lookdev.core.materials.rt_lit_interface import Features
-    from rt_lookdev.validation import energy_render
+    from rt_lookdev.validation.harness import scene_render
 
     scene = bpy.context.scene
-    mesh = energy_render._uv_sphere_mesh(bpy, "cull_sphere", 48, 24)
+    mesh = scene_render.uv_sphere_mesh("cull_sphere", 48, 24)
     for i in range(3):
         data = bpy.data.lights.new(f"Point {i}", "POINT")
         data.energy, data.shadow_soft_size = 300.0, 0.0
@@ -50,7 +50,7 @@ def _scene(bpy, lut_dir, ranged=True):
 
 
 def _render(scene):
-    from rt_lookdev.validation.engines import render_cycles_passes
+    from rt_lookdev.validation.harness.engines import render_cycles_passes
 
     return render_cycles_passes(scene, (scene.render.resolution_x, scene.render.resolution_y))["Combined"]
 

@@ -35,7 +35,7 @@ Z_MAX = 5.0
 
 def _scene(bpy):
     from rt_lookdev.addon import compat
-    from rt_lookdev.validation.render_setup import configure_cycles_measurement
+    from rt_lookdev.validation.harness.render_setup import configure_cycles_measurement
 
     bpy.ops.wm.read_homefile(use_empty=True)
     sc = bpy.context.scene

@@ -32,12 +32,12 @@ def _scene(bpy, luts):
     """A sphere with an RT Lit material under a point light, an orthographic camera, synced by the automatic sync."""
     from rt_lookdev.addon import compat, materials
     from rt_lookdev.core.materials.rt_lit_interface import Features
-    from rt_lookdev.validation import energy_render
+    from rt_lookdev.validation.harness import scene_render
 
     scene = bpy.context.scene
     mat = compat.new_material("Ball")
     materials.assign_rt_lit(mat, Features("turquin", "cod"), scene, luts)
-    ball = bpy.data.objects.new("Ball", energy_render._uv_sphere_mesh(bpy, "ball", 24, 12))
+    ball = bpy.data.objects.new("Ball", scene_render.uv_sphere_mesh("ball", 24, 12))
     ball.data.materials.append(mat)
     scene.collection.objects.link(ball)
     key = bpy.data.objects.new("A Key", bpy.data.lights.new("A Key", "POINT"))
@@ -95,7 +95,7 @@ def _file_state(bpy):
 
 
 def _render(scene):
-    from rt_lookdev.validation.engines import render_cycles_passes
+    from rt_lookdev.validation.harness.engines import render_cycles_passes
 
     return render_cycles_passes(scene, (8, 8))["Combined"]
 

@@ -56,7 +56,7 @@ DELTA_RTOL = 2e-4
 
 def _scene(bpy, samples, ortho_scale, center):
     from rt_lookdev.addon import compat
-    from rt_lookdev.validation.render_setup import configure_cycles_measurement
+    from rt_lookdev.validation.harness.render_setup import configure_cycles_measurement
 
     bpy.ops.wm.read_homefile(use_empty=True)
     sc = bpy.context.scene
@@ -348,7 +348,7 @@ def _vector_wrapper(bpy, inner):
 @pytest.mark.parametrize("fn", lights.NODE_FUNCTIONS + lights.CONTROL_FUNCTIONS, ids=lambda f: f.name)
 def test_node_group_renders_like_numpy(empty_scene, bpy_module, fn):
     """Each light function, emitted as its node group, gives the numpy backend's values in Cycles."""
-    from rt_lookdev.validation.conformance import render_group_outputs
+    from rt_lookdev.validation.harness.conformance import render_group_outputs
 
     from rt_lookdev.addon.node_emit import ensure_function_group
     from rt_lookdev.core.ir.numpy_backend import evaluate

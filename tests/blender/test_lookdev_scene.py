@@ -1,6 +1,6 @@
 """New Lookdev Scene and its path-traced twin (addon/lookdev_scene.py, addon/lookdev_operators.py), run
 headless as an artist would from the Add menu, and measured with the validation's metrics
-(validation/lookdev_twin.py)."""
+(validation/checks/lookdev_twin.py)."""
 
 import numpy as np
 import pytest
@@ -88,7 +88,7 @@ def test_twin_operator_refuses_a_scene_without_rt_lit(registered, empty_scene):
 def test_rt_lit_against_the_path_traced_twin(lookdev):
     """The acceptance measurement at a test's size: RT Lit within the gates of the main job's comparison
     of the path-traced twin (and EEVEE within its half-precision film of Cycles, where EEVEE renders)."""
-    from rt_lookdev.validation import lookdev_twin
+    from rt_lookdev.validation.checks import lookdev_twin
 
     _, scene, twin = lookdev
     result = lookdev_twin.compare(scene, twin, resolution=(200, 100), samples=64, eevee=True, log=print)

@@ -252,7 +252,7 @@ def test_twin_lights_its_copies_as_the_light_links_say(twin_setup, tmp_path):
     """16 x 16 Cycles renders, 16 samples: in the twin every object is seen, "Excluded"'s copy and "Plain" get no
     light from Key, as "Plain" gets none in the original (Cycles honours the light linking); "Multi" (both
     halves) and "Lit" are lit."""
-    from rt_lookdev.validation.lookdev_twin import render_measurement
+    from rt_lookdev.validation.checks.lookdev_twin import render_measurement
 
     bpy, scene, twin, _ = twin_setup
     rgb, index, _ = render_measurement(twin, (16, 16), 16, 0, tmp_path)

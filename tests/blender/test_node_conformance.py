@@ -9,10 +9,10 @@ from rt_lookdev.core import diffuse
 from rt_lookdev.core.ir import trace
 from rt_lookdev.core.ir.expr import topological_order
 from rt_lookdev.core.ir.numpy_backend import evaluate, node_count
-from rt_lookdev.validation.conformance import ATOL, LAST_RENDER_SECONDS, NEAR_ZERO, RTOL, render_group_outputs
-from rt_lookdev.validation.conformance import compare as _compare
-from rt_lookdev.validation.grids import TECHNIQUES, ir_operation_inputs
-from rt_lookdev.validation.grids import technique_inputs as _inputs
+from rt_lookdev.validation.harness.conformance import ATOL, LAST_RENDER_SECONDS, NEAR_ZERO, RTOL, render_group_outputs
+from rt_lookdev.validation.harness.conformance import compare as _compare
+from rt_lookdev.validation.harness.grids import TECHNIQUES, ir_operation_inputs
+from rt_lookdev.validation.harness.grids import technique_inputs as _inputs
 
 pytest.importorskip("OpenEXR")
 
@@ -108,7 +108,7 @@ def test_group_is_deterministic_and_one_node_per_operation(empty_scene):
 def test_every_ir_operation_renders_like_numpy(empty_scene):
     """One output per IR operation (every entry of OPS), out-of-domain arguments included."""
     from rt_lookdev.addon.node_emit import build_node_group
-    from rt_lookdev.validation.grids import ir_operation_graph
+    from rt_lookdev.validation.harness.grids import ir_operation_graph
 
     outputs = ir_operation_graph()
     ng = build_node_group("RTL_all_ops", outputs, input_order=["a", "b", "u", "v"])

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from rt_lookdev.core.materials.lobes import LOBES
-from rt_lookdev.validation.conformance import check_function
-from rt_lookdev.validation.grids import area_lobe_inputs as _area_inputs
-from rt_lookdev.validation.grids import punctual_lobe_inputs as _punctual_inputs
-from rt_lookdev.validation.grids import shade_inputs, surface_inputs, technique_function_inputs
+from rt_lookdev.validation.harness.conformance import check_function
+from rt_lookdev.validation.harness.grids import area_lobe_inputs as _area_inputs
+from rt_lookdev.validation.harness.grids import punctual_lobe_inputs as _punctual_inputs
+from rt_lookdev.validation.harness.grids import shade_inputs, surface_inputs, technique_function_inputs
 
 pytest.importorskip("OpenEXR")
 

@@ -60,7 +60,7 @@ def test_enabling_the_extension_lists_the_library_in_the_asset_browser(bpy_modul
 
 
 def _render(bpy, scene):
-    from rt_lookdev.validation.engines import render_cycles_passes
+    from rt_lookdev.validation.harness.engines import render_cycles_passes
 
     return render_cycles_passes(scene, (96, 48))["Combined"]
 

@@ -250,7 +250,7 @@ def _script_module(script):
 def world_exr(tmp_path_factory):
     """A small prefiltered environment EXR (what --world and --hdri of the examples read)."""
     from rt_lookdev.core.lut import exr_io
-    from rt_lookdev.validation import grids
+    from rt_lookdev.validation.harness import grids
 
     path = tmp_path_factory.mktemp("world") / "env_example.exr"
     exr_io.write_table(path, grids.smooth_environment(), {"table": "env_example",

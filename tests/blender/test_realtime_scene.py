@@ -1,13 +1,13 @@
 """The real-time backend end to end: a Blender scene with every light kind and a studio HDRI world,
 exported (addon/scene_export.py) and drawn by the standalone GLSL renderer, equals Cycles' render of its
-RT Lit node groups (targets of validation/demo_measure: median <= 1e-4, p99 <= 1e-3 relative); the
+RT Lit node groups (targets of validation/checks/demo_measure: median <= 1e-4, p99 <= 1e-3 relative); the
 export refuses a scene it cannot describe, saying what to change."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rt_lookdev.validation import lit_scene as rt_lit_scene
+from rt_lookdev.validation.harness import lit_scene as rt_lit_scene
 
 pytest.importorskip("OpenEXR")
 
@@ -16,7 +16,7 @@ pytestmark = [pytest.mark.blender, pytest.mark.glsl]
 
 @pytest.fixture
 def gl_available():
-    from rt_lookdev.validation import glsl_runner
+    from rt_lookdev.validation.harness import glsl_runner
 
     ok, why = glsl_runner.available()
     if not ok:
@@ -26,9 +26,9 @@ def gl_available():
 def test_exported_scene_draws_like_cycles(empty_scene, gl_available, lut_dir, tmp_path):
     from rt_lookdev.addon import scene_export
     from rt_lookdev.core.materials.rt_lit_interface import Features
-    from rt_lookdev.validation.demo_measure import GLSL_MEDIAN_TOL, GLSL_P99_TOL
-    from rt_lookdev.validation.engines import compare, render_cycles_passes
-    from rt_lookdev.validation.realtime_render import RealtimeRenderer
+    from rt_lookdev.validation.checks.demo_measure import GLSL_MEDIAN_TOL, GLSL_P99_TOL
+    from rt_lookdev.validation.harness.engines import compare, render_cycles_passes
+    from rt_lookdev.validation.harness.realtime_render import RealtimeRenderer
 
     scene = rt_lit_scene.build([("all", Features("kulla_conty", "wrapped", sheen=True, cloth=True)),
                                 ("typical", Features("turquin", "cod"))], resolution=64, hdri="forest", lut_dir=lut_dir)

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rt_lookdev.validation import lit_scene as rt_lit_scene
-from rt_lookdev.validation.engines import render_cycles_passes, render_reloaded
+from rt_lookdev.validation.harness import lit_scene as rt_lit_scene
+from rt_lookdev.validation.harness.engines import render_cycles_passes, render_reloaded
 
 pytest.importorskip("OpenEXR")
 

@@ -1,6 +1,6 @@
 """The shipped Zeltner sheen table (luts/zeltner_sheen.exr) against Cycles, re-measured.
 
-A few cells are rendered again in Cycles (validation/sheen_table.py: Sheen BSDF "Microfiber", one sun of
+A few cells are rendered again in Cycles (validation/benchmarks/sheen_table.py: Sheen BSDF "Microfiber", one sun of
 angle 0 at a time, 1 sample, direct light: each pixel is f cos exactly) and compared with RT Lit's punctual
 Zeltner lobe (core/sheen.py with the shipped table's bilinear lookup) at the same directions:
 - cells at table nodes: the refitted (a, b, albedo) equal the stored ones (measured: <= 1e-6 relative; the
@@ -21,7 +21,7 @@ pytest.importorskip("OpenEXR")
 from rt_lookdev.core import sheen  # noqa: E402
 from rt_lookdev.core.lut import catalog, exr_io  # noqa: E402
 from rt_lookdev.core.lut.lookup import LutSet  # noqa: E402
-from rt_lookdev.validation import sheen_table  # noqa: E402
+from rt_lookdev.validation.benchmarks import sheen_table  # noqa: E402
 
 pytestmark = pytest.mark.blender
 
@@ -80,10 +80,10 @@ def test_provenance():
 
 
 def test_ashikhmin_velvet_formula_matches_cycles():
-    """validation/velvet.py's reading of Cycles' Sheen BSDF "Ashikhmin" (the velvet RT Lit's cloth is compared
+    """validation/harness/velvet.py's reading of Cycles' Sheen BSDF "Ashikhmin" (the velvet RT Lit's cloth is compared
     with in docs/sheen.md) against renders of it (measured: max 1.7e-5 relative where f cos > 1e-3 of the cell's
     peak)."""
-    from rt_lookdev.validation import velvet
+    from rt_lookdev.validation.harness import velvet
 
     cells = np.array([[[0.3, 0.3], [0.6, 0.5], [0.9, 0.8], [0.15, 0.65]]])
     values, directions, _ = sheen_table.render_lobe(cells, sheen_table.sun_directions(), distribution="ASHIKHMIN")

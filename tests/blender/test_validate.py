@@ -35,7 +35,7 @@ PUNCTUAL_TOL = (0.002, 0.01)         # deterministic lights: the BRDFs themselve
 
 @pytest.fixture(scope="module")
 def validation(tmp_path_factory, lut_dir, bpy_module):
-    from rt_lookdev.validation import suite as validate
+    from rt_lookdev.validation.checks import suite as validate
 
     out = tmp_path_factory.mktemp("validation")
     args = validate.parse_args(["--quick", "--out", str(out), "--samples", "64", "--brute-pixels", "80",

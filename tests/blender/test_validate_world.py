@@ -32,7 +32,7 @@ HARNESS_MEDIAN = 0.025         # texel-sum Lambert vs Cycles at 256 spp x 2: noi
 
 @pytest.fixture(scope="module")
 def world_validation(tmp_path_factory, lut_dir, bpy_module):
-    from rt_lookdev.validation import world_suite as validate_world
+    from rt_lookdev.validation.checks import world_suite as validate_world
 
     out = tmp_path_factory.mktemp("validation_world")
     argv = ["--quick", "--no-bake-timing", "--out", str(out), "--lut-dir", str(lut_dir),

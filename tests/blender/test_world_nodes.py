@@ -3,7 +3,7 @@
 Every function of the world term, fed 48 x 48 grids of inputs (directions over the whole sphere
 with the poles and the equirect seam, roughness 0 and 1 and between levels, V below the horizon,
 rotations), is emitted as its node group and rendered; each output is compared with the traced
-graph evaluated in float32 (validation.conformance.check_function: 1e-4 relative, 1e-6 absolute near zero).  The
+graph evaluated in float32 (validation.harness.conformance.check_function: 1e-4 relative, 1e-6 absolute near zero).  The
 prefiltered environment is a random 9-level table written as an EXR like the bake's.
 """
 from __future__ import annotations
@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rt_lookdev.validation.conformance import check_function
-from rt_lookdev.validation.grids import ENVIRONMENT_LEVELS as LEVELS
-from rt_lookdev.validation.grids import random_environment, smooth_environment, world_inputs
+from rt_lookdev.validation.harness.conformance import check_function
+from rt_lookdev.validation.harness.grids import ENVIRONMENT_LEVELS as LEVELS
+from rt_lookdev.validation.harness.grids import random_environment, smooth_environment, world_inputs
 
 pytest.importorskip("OpenEXR")
 
@@ -78,12 +78,12 @@ def test_shade_world_computes_the_same_in_eevee(empty_scene, tables, tmp_path):
     """Identical inputs through the whole world group in both engines, on a smooth environment (a
     random table would turn Mesa's approximate arccosine, 3.1e-4 relative (docs/conventions.md), into
     texel-to-texel jumps): EEVEE's half-float film is the only difference allowed."""
-    from rt_lookdev.validation.engines import eevee_available
+    from rt_lookdev.validation.harness.engines import eevee_available
 
     ok, why = eevee_available()
     if not ok:
         pytest.skip(why)
-    from rt_lookdev.validation.conformance import render_group_outputs
+    from rt_lookdev.validation.harness.conformance import render_group_outputs
 
     from rt_lookdev.addon import node_emit
     from rt_lookdev.core.lut import exr_io

@@ -175,7 +175,7 @@ def test_environment_bake_without_openexr_equals_the_openexr_bake(tmp_path, monk
 def test_multi_part_files_read_like_openexr(tmp_path, monkeypatch, compression):
     """Blender's multilayer renders are multi-part EXRs: the built-in reader gives every part's channels, as
     the OpenEXR package does, so the validation reads renders in a Python without OpenEXR (Blender's)."""
-    from rt_lookdev.validation import exr_images
+    from rt_lookdev.validation.harness import exr_images
 
     rng = np.random.default_rng(7)
     parts = []

@@ -6,8 +6,8 @@ from rt_lookdev.core import cloth, diffuse
 from rt_lookdev.core import shading_ops as op
 from rt_lookdev.core.ir import Graph, trace
 from rt_lookdev.core.ir.numpy_backend import evaluate, node_count
-from rt_lookdev.validation.grids import TECHNIQUES
-from rt_lookdev.validation.grids import technique_inputs as _inputs
+from rt_lookdev.validation.harness.grids import TECHNIQUES
+from rt_lookdev.validation.harness.grids import technique_inputs as _inputs
 
 
 def test_common_subexpressions_are_shared():

@@ -7,7 +7,7 @@ from rt_lookdev.core import sampling
 from rt_lookdev.core.ltc import fit, matrix, optimize, polygon, reference, shading
 from rt_lookdev.core.ltc import fit_lobes as lobes
 from rt_lookdev.core.lut import catalog, lookup
-from rt_lookdev.validation import ltc_suite_like
+from rt_lookdev.validation.benchmarks import ltc_suite_like
 
 BAND = catalog.LTC_BANDS["ltc_ggx"]
 
@@ -112,7 +112,7 @@ def test_fitter_recovers_a_band_mixture():
 
 def test_rough_lobes_on_a_suite_like_light(tables):
     """The shipped GGX LTC (with its band) against brute force at the suite's quad0 light, 40 points per sphere
-    (of a 32-pixel grid per cell), r = 0.8 and 1 (validation/ltc_suite_like.py): the tables without the band
+    (of a 32-pixel grid per cell), r = 0.8 and 1 (validation/benchmarks/ltc_suite_like.py): the tables without the band
     (a8bb34f) gave an RMS relative error of 7.7% and 5.1%, a median of 2.5% and 3.3%; with it 3.3% and 1.1%,
     1.0% and 0.7%."""
     entry = ltc_suite_like.build_set(cell=32, pixels=40)[0]

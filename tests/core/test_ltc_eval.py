@@ -131,7 +131,7 @@ def test_sphere_table_interpolation_error():
 
 
 def test_sphere_table_matches_ltc_code():
-    from rt_lookdev.validation import published_ltc as ltc_anchor
+    from rt_lookdev.validation.harness import published_ltc as ltc_anchor
     try:
         _, ltc2 = ltc_anchor.load_anchor()
     except FileNotFoundError:
@@ -338,7 +338,7 @@ def test_disk_polygon_fallback_converges():
 # --- GGX matrices of the published table (comparison only) -------------------------------------
 
 def test_published_ggx_matrices():
-    from rt_lookdev.validation import published_ltc as ltc_anchor
+    from rt_lookdev.validation.harness import published_ltc as ltc_anchor
     try:
         ltc1, _ = ltc_anchor.load_anchor()
     except FileNotFoundError:

@@ -112,7 +112,7 @@ def test_rotation_keeps_layout_and_turns_the_lobe():
 
 
 def _anchor():
-    from rt_lookdev.validation import published_ltc as ltc_anchor
+    from rt_lookdev.validation.harness import published_ltc as ltc_anchor
 
     try:
         return ltc_anchor.load_anchor()

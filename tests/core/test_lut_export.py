@@ -144,7 +144,8 @@ def read_ltc_code_dds(path):
 
 
 def test_ltc_code_layout_gives_the_rtl_figures(export_ltc_code, lut_dir):
-    from rt_lookdev.validation import ltc_benchmark
+    from rt_lookdev.validation.benchmarks import ltc_benchmark
+    from rt_lookdev.validation.benchmarks import ltc_random_lights
 
     rtl = {name: ltc_benchmark.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}
     swapped = {}
@@ -153,15 +154,15 @@ def test_ltc_code_layout_gives_the_rtl_figures(export_ltc_code, lut_dir):
         swapped[prefix + "_inv"] = read_ltc_code_dds(export_ltc_code.folder / f"{stem}_1_f32.dds")
         swapped[prefix + "_mag"] = read_ltc_code_dds(export_ltc_code.folder / f"{stem}_2_f32.dds")
         np.testing.assert_array_equal(swapped[prefix + "_inv"], rtl[prefix + "_inv"])
-    ours = ltc_benchmark.end_to_end(rtl, None, 10, 5)
-    theirs = ltc_benchmark.end_to_end(swapped, None, 10, 5)
+    ours = ltc_random_lights.end_to_end(rtl, None, 10, 5)
+    theirs = ltc_random_lights.end_to_end(swapped, None, 10, 5)
     assert json.dumps(ours, sort_keys=True) == json.dumps(theirs, sort_keys=True)
 
 
 def test_ltc_code_layout_matches_the_published_table(export_ltc_code):
     """Our ltc_1 read as the published one is, beside the published GGX table: the same channels in the same
     places (its transpose, or the view axis flipped, is far off)."""
-    from rt_lookdev.validation import published_ltc
+    from rt_lookdev.validation.harness import published_ltc
 
     try:
         ltc1, _ = published_ltc.load_anchor()

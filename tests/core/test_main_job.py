@@ -29,3 +29,12 @@ def test_report_is_written_from_the_steps(tmp_path, monkeypatch):
     assert all(f"{s} TABLE" in text for s in ("RENDER", "LUT_EXPORT", "DEMO", "LOOKDEV_TWIN", "REALTIME_BENCHMARK", "VALIDATION",
                                               "WORLD_VALIDATION", "ROBUSTNESS", "SPEED_ERROR"))
     assert "Skipped" not in text
+    assert "quick forms of the validation suite" in text and "--full" in text     # the report says what ran
+    job["mode"], job["step_seconds"] = "full", {"luts": 1.5, "ltc": 18.3}
+    main_job.write_report(job, tmp_path / "whole")
+    text = (tmp_path / "whole" / "report.md").read_text()
+    assert "`bash scripts/main.sh --full`" in text and "| ltc | 18.3 |" in text
+
+
+def test_quick_by_default_and_whole_with_full():
+    assert not main_job.parse_args([]).full and main_job.parse_args(["--full"]).full

@@ -14,7 +14,7 @@ from rt_lookdev.core import cloth, diffuse, microfacet
 from rt_lookdev.core.conventions import alpha_from_roughness
 from rt_lookdev.core.materials import rt_lit
 from rt_lookdev.core.materials.rt_lit_interface import RADIANCE_OUTPUT, Features
-from rt_lookdev.validation import robustness
+from rt_lookdev.validation.checks import robustness, robustness_inputs
 
 #: Fixed seed (derandomize) and a bounded number of examples: the suite stays fast and repeatable.
 PROPERTIES = settings(max_examples=40, derandomize=True, deadline=None, database=None,
@@ -76,7 +76,7 @@ def test_cod_diffuse_never_negative():
 @given(family=st.sampled_from(robustness.FAMILIES), kind=st.sampled_from(robustness.LIGHT_KINDS),
        seed=st.integers(0, 2 ** 16))
 def test_material_finite_non_negative_bounded(tables, family, kind, seed):
-    """The RT Lit material at scene-like and adversarial points (validation/robustness.py's draw)."""
+    """The RT Lit material at scene-like and adversarial points (validation/checks/robustness.py's draw)."""
     values, unit, material = robustness.scene_inputs(family, kind, 256, seed)
     got = robustness.evaluate_numpy(material, values, tables, np.float32)
     ref = robustness.evaluate_numpy(material, values, tables, np.float64)
@@ -130,7 +130,7 @@ def test_denormal_normal_falls_back(tables):
 
 def _aimed_light(kind, location, target, size, power):
     """Driver values of one light at ``location`` aimed at ``target``."""
-    q = robustness._facing(None, np.asarray([location], float), np.asarray([target], float), 1)[0]
+    q = robustness_inputs._facing(None, np.asarray([location], float), np.asarray([target], float), 1)[0]
     vals = {"Location X": location[0], "Location Y": location[1], "Location Z": location[2], "Rotation W": q[0],
             "Rotation X": q[1], "Rotation Y": q[2], "Rotation Z": q[3], "Scale X": 1.0, "Scale Y": 1.0,
             "Scale Z": 1.0, "Power": power, "Color R": 1.0, "Color G": 1.0, "Color B": 1.0, "Size": size,

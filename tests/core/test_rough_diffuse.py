@@ -142,7 +142,7 @@ def test_reciprocal_and_white_furnace():
     for r in (0.0, 0.5, 1.0):
         mu = np.linspace(0, 1, 11)
         np.testing.assert_allclose(rd.directional_albedo(1.0, mu, r), 1.0, atol=1e-12)
-    # the furnace render (validation/rough_diffuse_furnace.py, Blender 4.5.15 and 5.2.3, rho 0.5, sigma 1): the
+    # the furnace render (validation/checks/rough_diffuse_furnace.py, Blender 4.5.15 and 5.2.3, rho 0.5, sigma 1): the
     # sphere's pixels in the bin mu 0.9 - 1 (density ~ mu under an orthographic camera) averaged 0.4148 +- 0.0001
     # and 0.4222 in 0.7 - 0.9; EON's colour would give 0.4398 and 0.4451
     for (lo, hi), rendered in (((0.9, 1.0), 0.4148), ((0.7, 0.9), 0.4222)):

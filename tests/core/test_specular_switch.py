@@ -10,7 +10,7 @@ from rt_lookdev.core.ir.tables import table_names
 from rt_lookdev.core.lut import lookup
 from rt_lookdev.core.materials import light_shading, rt_lit
 from rt_lookdev.core.materials.rt_lit_interface import SPECULAR_MODELS, Features
-from rt_lookdev.validation import grids
+from rt_lookdev.validation.harness import grids
 
 KINDS = ("quad", "disk", "point", "spot", "sun")
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from rt_lookdev.validation import suite
-from rt_lookdev.validation import suite_cases as cases
+from rt_lookdev.validation.checks import suite
+from rt_lookdev.validation.checks import suite_cases as cases
 
 
 def test_every_technique_under_every_light_kind_has_a_gate():

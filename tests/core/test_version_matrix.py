@@ -1,5 +1,5 @@
-"""The table of ``bash scripts/test.sh --matrix`` from the files each run leaves (validation/version_matrix.py)."""
-from rt_lookdev.validation import version_matrix
+"""The table of ``bash scripts/test.sh --matrix`` from the files each run leaves (validation/tools/version_matrix.py)."""
+from rt_lookdev.validation.tools import version_matrix
 
 XML = """<?xml version="1.0" encoding="utf-8"?><testsuites><testsuite name="pytest" errors="{e}" failures="{f}"
 skipped="{s}" tests="{t}" time="1.0"></testsuite></testsuites>"""

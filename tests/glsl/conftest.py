@@ -14,7 +14,7 @@ def _unavailable(why):
 
 @pytest.fixture(scope="session")
 def gl():
-    from rt_lookdev.validation import glsl_runner
+    from rt_lookdev.validation.harness import glsl_runner
 
     ok, why = glsl_runner.available()
     if not ok:
@@ -24,7 +24,7 @@ def gl():
 
 @pytest.fixture(scope="session")
 def glslang_path():
-    from rt_lookdev.validation import glslang
+    from rt_lookdev.validation.harness import glslang
 
     path = glslang.executable()
     if path is None:

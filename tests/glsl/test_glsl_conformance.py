@@ -3,15 +3,15 @@ the RT Lit functions up to the whole material, emitted as GLSL 4.50, evaluated p
 OpenGL context (Mesa's llvmpipe here), equal the numpy backend in float32: <= 1e-5 relative, <= 1e-7
 absolute where |numpy| < 1e-2, and finite everywhere.  Where a function amplifies float32 rounding itself
 (numpy's float32 evaluation is off its float64 evaluation by a tenth of the tolerance or more), GLSL must be
-no farther from float64 than twice numpy's float32 (validation.glsl_runner.Conformance)."""
+no farther from float64 than twice numpy's float32 (validation.harness.glsl_runner.Conformance)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from rt_lookdev.core.ir import trace
-from rt_lookdev.validation.glsl_runner import ATOL, RTOL, compare_function
-from rt_lookdev.validation import grids
+from rt_lookdev.validation.harness.glsl_runner import ATOL, RTOL, compare_function
+from rt_lookdev.validation.harness import grids
 
 pytestmark = pytest.mark.glsl
 

@@ -12,7 +12,7 @@ import pytest
 from rt_lookdev.core.export import lut_code, luts
 from rt_lookdev.core.ir import semantics
 from rt_lookdev.core.ir.tables import Table
-from rt_lookdev.validation import glslang
+from rt_lookdev.validation.harness import glslang
 
 pytestmark = pytest.mark.glsl
 
@@ -40,7 +40,7 @@ def test_half_lookups_decode_on_the_gpu(gl, lut_dir):
     """rtl_lookup_<table> over the half-precision texture (stored values, scaled) returns the float32
     table's bilinear lookup within half's rounding, for every table of the rtl layout."""
     from rt_lookdev.core.lut.lookup import LutSet
-    from rt_lookdev.validation.glsl_runner import compare_function
+    from rt_lookdev.validation.harness.glsl_runner import compare_function
 
     rng = np.random.default_rng(4)
     for table in luts.layout_tables(LutSet.from_folder(lut_dir), "rtl"):

@@ -1,4 +1,4 @@
-"""The standalone renderer on scene descriptions written without Blender (validation/realtime_benchmark's
+"""The standalone renderer on scene descriptions written without Blender (validation/benchmarks/realtime_benchmark's
 frame-filling sphere): the scene description round-trips and refuses what it cannot read, the camera
 puts world points on the pixels Blender's would, and the drawn image is the material function
 evaluated by numpy at the rasterised points.  (Against Cycles: tests/blender/test_realtime_scene.py.)"""
@@ -12,7 +12,7 @@ import pytest
 
 from rt_lookdev.core.export import scene as scene_io
 from rt_lookdev.core.materials.rt_lit_interface import Features
-from rt_lookdev.validation import realtime_benchmark as bench
+from rt_lookdev.validation.benchmarks import realtime_benchmark as bench
 
 pytestmark = pytest.mark.glsl
 
@@ -129,8 +129,8 @@ def _rasterise_orthographic(cam, positions, normals, size):
 def test_render_is_the_material_function_at_the_rasterised_points(gl, sphere_scene):
     """Each pixel equals the numpy evaluation (float32) of the same material function at the point and
     normal the pixel centre sees on the exported triangles (interpolated as a rasteriser does)."""
-    from rt_lookdev.validation.glsl_runner import conformance
-    from rt_lookdev.validation.realtime_render import RealtimeRenderer
+    from rt_lookdev.validation.harness.glsl_runner import conformance
+    from rt_lookdev.validation.harness.realtime_render import RealtimeRenderer
 
     with RealtimeRenderer(sphere_scene) as renderer:
         image = renderer.render()
@@ -157,7 +157,7 @@ def test_render_is_the_material_function_at_the_rasterised_points(gl, sphere_sce
 
 def test_power_scales_the_image_and_lights_add_up(gl, tmp_path, lut_dir):
     """Doubling a light's power doubles its pixels; uniforms reach each light of an array by its index."""
-    from rt_lookdev.validation.realtime_render import RealtimeRenderer
+    from rt_lookdev.validation.harness.realtime_render import RealtimeRenderer
 
     desc = bench.write_scene(tmp_path / "quad", Features("single", "lambert"), False, 4, SIZE, lut_dir)
     with RealtimeRenderer(desc) as r:
@@ -175,8 +175,8 @@ def test_power_scales_the_image_and_lights_add_up(gl, tmp_path, lut_dir):
 
 def test_unsupported_features_and_refused_shaders_are_named(gl, sphere_scene, tmp_path, monkeypatch):
     from rt_lookdev.core.materials import rt_lit_shader
-    from rt_lookdev.validation import glsl_runner
-    from rt_lookdev.validation.realtime_render import RealtimeRenderer
+    from rt_lookdev.validation.harness import glsl_runner
+    from rt_lookdev.validation.harness.realtime_render import RealtimeRenderer
 
     folder = tmp_path / "copy"
     shutil.copytree(sphere_scene.folder, folder)

@@ -15,8 +15,8 @@ import pytest
 
 from rt_lookdev.core.ir import shader_text, trace
 from rt_lookdev.core.ir.expr import Function
-from rt_lookdev.validation import glslang
-from rt_lookdev.validation.grids import TECHNIQUES
+from rt_lookdev.validation.harness import glslang
+from rt_lookdev.validation.harness.grids import TECHNIQUES
 
 pytestmark = pytest.mark.glsl
 
@@ -74,7 +74,7 @@ MATERIALS["turquin + Oren-Nayar, every light kind, world"] = (dict(specular="tur
 def environment(tmp_path_factory):
     from rt_lookdev.core.lut import exr_io
     from rt_lookdev.core.materials import world_shading as world
-    from rt_lookdev.validation import grids
+    from rt_lookdev.validation.harness import grids
 
     path = tmp_path_factory.mktemp("env") / "env_compile.exr"
     exr_io.write_table(path, grids.smooth_environment(), {"table": "env_compile",
@@ -258,7 +258,7 @@ def test_docs_show_the_interface_the_code_emits(tmp_path):
     from rt_lookdev.core.lut import exr_io
     from rt_lookdev.core.materials import rt_lit_shader
     from rt_lookdev.core.materials import world_shading as world
-    from rt_lookdev.validation import grids
+    from rt_lookdev.validation.harness import grids
 
     path = tmp_path / "env.exr"
     exr_io.write_table(path, grids.smooth_environment(64, 128), {"table": "env_0123456789ab",
