@@ -32,7 +32,7 @@ Steps (each prints what it does):
    (Lambert vs Cycles Diffuse, SH-LTC CoD vs brute force, specular vs Cycles Glossy over a roughness
    sweep, the white furnace, node render vs numpy, bake times), report in <out>/validation_world/.
 11. Robustness sweep, quick (scripts/robustness_sweep.py --points 2000): NaN, Inf, negative and
-   over-bound counts per technique family and backend.
+   over-bound counts per technique family and backend (numpy and GLSL; the node groups in Cycles too with --full).
 12. Speed vs error, quick (scripts/benchmark_speed_error.py --quick): RT Lit in Cycles, in EEVEE, as GLSL and in
    numpy against Cycles path tracing of the same BRDFs at 1 ... 256 spp, the equal-error speedup per family, into
    <out>/benchmarks/speed_error/ (the full run is docs/benchmarks/speed_error.md).
@@ -172,12 +172,19 @@ def step_lut_export(out_dir, lut_dir, log=entry.flush_log):
     return out
 
 
-def step_robustness(out_dir, lut_dir, log=entry.flush_log):
+#: The backends of the quick job's robustness sweep: the node groups in Cycles (127 of its 205 s at 2,000 points,
+#: 2026-12-03) run with --full and in the full sweep (docs/benchmarks/robustness.md).
+QUICK_ROBUSTNESS_BACKENDS = "numpy,glsl"
+
+
+def step_robustness(out_dir, lut_dir, log=entry.flush_log, full=False):
+    backends = "numpy,glsl,cycles" if full else QUICK_ROBUSTNESS_BACKENDS
     log("[11/13] robustness sweep, quick: NaN / Inf / negative / over-bound counts per family and backend "
-        "(scripts/robustness_sweep.py --points 2000)")
+        f"(scripts/robustness_sweep.py --points 2000 --backends {backends})")
 
     out = out_dir / "benchmarks" / "robustness.md"
-    argv = ["--points", "2000", "--out", str(out)] + (["--lut-dir", str(lut_dir)] if lut_dir else [])
+    argv = ["--points", "2000", "--backends", backends, "--out", str(out)] + \
+        (["--lut-dir", str(lut_dir)] if lut_dir else [])
     result = robustness.run(robustness.parse_args(argv), log=lambda line: None)
     rows = ["| backend | evaluations | NaN | Inf | negative | over bound |", "|---|---|---|---|---|---|"]
     for backend, families in result["summary"].items():
@@ -420,7 +427,7 @@ def run(args, log=entry.flush_log):
     if not args.skip_render:
         _timed(job, "validation", step_validation, args.out, args.lut_dir, log, args.full)
         _timed(job, "world_validation", step_world_validation, args.out, args.lut_dir, log, args.full)
-    _timed(job, "robustness", step_robustness, args.out, args.lut_dir, log)
+    _timed(job, "robustness", step_robustness, args.out, args.lut_dir, log, args.full)
     if not args.skip_render:
         _timed(job, "speed_error", step_speed_error, args.out, args.lut_dir, eevee=not args.skip_eevee, log=log)
     job["passed"] = _passed(job)
