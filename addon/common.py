@@ -313,6 +313,18 @@ def node_groups_kept_on_error():
 _SNAPSHOTS = []
 
 
+def replace_group(in_use, rebuilt):
+    """Give ``rebuilt`` (a group built where no tree used it) the users and the name of ``in_use``, and remove
+    ``in_use``.  For Group nodes to keep their links, ``rebuilt`` must have ``in_use``'s interface socket identifiers
+    (build it in ``in_use.copy()``)."""
+    import bpy
+
+    name = in_use.name
+    in_use.user_remap(rebuilt)
+    bpy.data.node_groups.remove(in_use)
+    rebuilt.name = name
+
+
 def before_rebuild(ng):
     """Called by the emitter before it clears a group to rebuild it in place: a transaction under way keeps a copy."""
     for snapshot in _SNAPSHOTS:
@@ -340,13 +352,13 @@ class _GroupSnapshot:
         import bpy
 
         data = bpy.data
-        self.before = {ng.as_pointer() for ng in data.node_groups}
-        self.images = {image.as_pointer() for image in data.images}
+        self.before = {ng.session_uid for ng in data.node_groups}
+        self.images = {image.session_uid for image in data.images}
         self.groups = []               # (original, its name, its custom properties, its copy)
-        self.copies = {}               # original's pointer -> copy
+        self.copies = {}               # original's session_uid -> copy
         tops = [ng for ng in data.node_groups
                 if ng.library is None and (FEATURES_KEY in ng or ng.name == SCENE_LIGHTS_GROUP)]
-        trees = {node.node_tree.as_pointer(): node.node_tree for ng in tops for node in ng.nodes
+        trees = {node.node_tree.session_uid: node.node_tree for ng in tops for node in ng.nodes
                  if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None and node.node_tree.library is None}
         for ng in tops + list(trees.values()):
             self._copy(ng)
@@ -356,29 +368,29 @@ class _GroupSnapshot:
         for material in data.materials:
             node = material.node_tree.nodes.get(RT_LIT_NODE_NAME) if material.node_tree is not None else None
             if node is not None and node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
-                self.assigned.append((material, self.copies.get(node.node_tree.as_pointer(), node.node_tree)))
+                self.assigned.append((material, self.copies.get(node.node_tree.session_uid, node.node_tree)))
 
     def _copy(self, ng):
-        if ng.as_pointer() in self.copies:
+        if ng.session_uid in self.copies:
             return None
         copy = ng.copy()
         properties = {key: _plain(ng[key]) for key in ng.keys()}
         for key in properties:
             del copy[key]
         self.groups.append((ng, ng.name, properties, copy))
-        self.copies[ng.as_pointer()] = copy
+        self.copies[ng.session_uid] = copy
         return copy
 
     def _point_at_copies(self, tree):
         for node in tree.nodes:
             if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None:
-                copy = self.copies.get(node.node_tree.as_pointer())
+                copy = self.copies.get(node.node_tree.session_uid)
                 if copy is not None and copy != tree:
                     node.node_tree = copy
 
     def keep(self, ng):
         """Copy ``ng``, about to be rebuilt in place, if it existed before the body and is not copied yet."""
-        if ng.as_pointer() in self.before and self._copy(ng) is not None:
+        if ng.session_uid in self.before and self._copy(ng) is not None:
             for *_, copy in self.groups:
                 self._point_at_copies(copy)
 
@@ -390,14 +402,14 @@ class _GroupSnapshot:
             node = material.node_tree.nodes.get(RT_LIT_NODE_NAME)
             if node is not None and node.node_tree != group:
                 node.node_tree = group
-        kept = self.before | {copy.as_pointer() for *_, copy in self.groups}
-        removed = [ng for ng in data.node_groups if ng.as_pointer() not in kept]
+        kept = self.before | {copy.session_uid for *_, copy in self.groups}
+        removed = [ng for ng in data.node_groups if ng.session_uid not in kept]
         for ng, _, _, copy in self.groups:
             if not _removed(ng):
                 ng.user_remap(copy)
                 removed.append(ng)
         removed += [image for image in data.images
-                    if image.as_pointer() not in self.images and image.name.startswith(IMAGE_PREFIX)]
+                    if image.session_uid not in self.images and image.name.startswith(IMAGE_PREFIX)]
         data.batch_remove(removed)
         for _, name, properties, copy in self.groups:
             copy.name = name
@@ -409,7 +421,7 @@ class _GroupSnapshot:
 
         data = bpy.data
         # the body removed these (culled groups no material uses); what they used, only their copies use now
-        used = {node.node_tree.as_pointer() for ng, _, _, copy in self.groups if _removed(ng)
+        used = {node.node_tree.session_uid for ng, _, _, copy in self.groups if _removed(ng)
                 for node in copy.nodes if node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None}
         data.batch_remove([copy for *_, copy in self.groups])
-        data.batch_remove([ng for ng in data.node_groups if ng.as_pointer() in used and ng.users == 0])
+        data.batch_remove([ng for ng in data.node_groups if ng.session_uid in used and ng.users == 0])

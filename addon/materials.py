@@ -28,7 +28,7 @@ from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, R
 from . import compat, light_controls, light_model, node_emit, world_sync
 from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LINKING_KEY, LIGHTS_SIGNATURE_KEY, LIGHTS_SUBSET_KEY, REACH_KEY,
                      RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP, STAMP_KEY,
-                     WORLD_GROUP, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers,
+                     WORLD_GROUP, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers, replace_group,
                      socket_by_identifier)
 from .light_model import light_kind
 
@@ -79,14 +79,9 @@ def scene_lights(scene):
 
 
 def sync_scene_lights(scene):
-    """(Re)build the "RTL Scene Lights" group for ``scene``; returns [(object, kind)]."""
+    """(Re)build the "RTL Scene Lights" group for ``scene`` (kept as it is when it already delivers the scene's
+    lights, ``_delivers``); returns [(object, kind)]."""
     records = scene_lights(scene)
-    ng = bpy.data.node_groups.get(SCENE_LIGHTS_GROUP)
-    if ng is None:
-        ng = bpy.data.node_groups.new(SCENE_LIGHTS_GROUP, "ShaderNodeTree")
-    remove_drivers(ng)
-    ng.nodes.clear()
-    ng.description = "Driver values of the scene's lights (rebuilt by RT Lookdev > Sync Lights)"
     plan = []
     for index, (obj, kind) in enumerate(records):
         if core_lights.split_kind(kind)[1] or core_lights.base_kind(kind) == "quad_spot":
@@ -97,22 +92,69 @@ def sync_scene_lights(scene):
             plan.append((light_input(index, param), obj, source,
                          Socket("float", 0.0, description=f"{obj.name}: {param} ({source[0]} {source[1]})",
                                 panel=f"Light {index}: {obj.name}")))
-    # an unchanged interface is kept, so RT Lit groups using this one keep their links
-    items = ensure_interface(ng, [(name, "OUTPUT", FLOAT, spec) for name, _, _, spec in plan])
-    out = ng.nodes.new("NodeGroupOutput")
-    for row, (name, obj, source, _) in enumerate(plan):
-        value = ng.nodes.new("ShaderNodeValue")
-        value.name = value.label = name
-        value.location = (0.0, -row * 90.0)
-        value.outputs[0].default_value = light_model.static_value(obj, source)
-        light_model.add_light_driver(value.outputs[0], obj, source)
-        ng.links.new(value.outputs[0], socket_by_identifier(out.inputs, items[(name, "OUTPUT")].identifier))
-    out.location = (400.0, 0.0)
-    ng[LIGHTS_RECORD_KEY] = [f"{obj.name}:{kind}" for obj, kind in records]
-    ng[LIGHTS_SIGNATURE_KEY] = light_signature(records)
+    signature = light_signature(records)
+    in_use = bpy.data.node_groups.get(SCENE_LIGHTS_GROUP)
+    if _delivers(in_use, signature, plan):
+        ng = in_use
+    else:
+        ng = _build_lights_group(in_use, plan)
+        ng[LIGHTS_RECORD_KEY] = [f"{obj.name}:{kind}" for obj, kind in records]
+        ng[LIGHTS_SIGNATURE_KEY] = signature
     ng[LINKING_KEY] = {name: attr for name, (attr, _) in light_model.linking_attributes(records).items()}
     light_model.sync_linking(scene.objects, records)
     return records
+
+
+def _build_lights_group(in_use, plan):
+    """The lights group for ``plan`` [(output name, object, driver source, Socket)]: one Value node per output, driven.
+
+    Built in a copy of the group in use (which no tree uses), then swapped in (``replace_group``): every edit of a
+    group in use is propagated to the trees that use it (the RT Lit trees, thousands of nodes), which made a sync of
+    100 lights take minutes (docs/benchmarks/light_sync.md).  The copy keeps the interface's socket identifiers, and
+    an unchanged interface is kept (``ensure_interface``), so the links of the trees using it hold."""
+    ng = in_use.copy() if in_use is not None else bpy.data.node_groups.new(SCENE_LIGHTS_GROUP, "ShaderNodeTree")
+    try:
+        remove_drivers(ng)
+        ng.nodes.clear()
+        ng.description = "Driver values of the scene's lights (rebuilt by RT Lookdev > Sync Lights)"
+        items = ensure_interface(ng, [(name, "OUTPUT", FLOAT, spec) for name, _, _, spec in plan])
+        out = ng.nodes.new("NodeGroupOutput")
+        for row, (name, obj, source, _) in enumerate(plan):
+            value = ng.nodes.new("ShaderNodeValue")
+            value.name = value.label = name
+            value.location = (0.0, -row * 90.0)
+            value.outputs[0].default_value = light_model.static_value(obj, source)
+            light_model.add_light_driver(value.outputs[0], obj, source)
+            ng.links.new(value.outputs[0], socket_by_identifier(out.inputs, items[(name, "OUTPUT")].identifier))
+        out.location = (400.0, 0.0)
+    except BaseException:
+        if in_use is not None:          # the group in use stays as it was
+            bpy.data.node_groups.remove(ng)
+        raise
+    if in_use is not None:
+        replace_group(in_use, ng)
+    return ng
+
+
+def _delivers(ng, signature, plan):
+    """Whether the lights group ``ng`` delivers ``plan`` as it is: synced for the same light ``signature``, one driven
+    Value node linked per output, and every driver reading the light object (or its light data) it was made for.  A
+    light deleted and another made under its name gives the same signature, but drivers that read nothing."""
+    if ng is None or list(ng.get(LIGHTS_SIGNATURE_KEY, [])) != signature:
+        return False
+    drivers = ng.animation_data.drivers if ng.animation_data is not None else ()
+    if not len(ng.nodes) == len(ng.links) + 1 == len(plan) + 1 == len(drivers) + 1:
+        return False
+    wanted = {f'nodes["{name}"].outputs[0].default_value': obj for name, obj, _, _ in plan}
+    for fc in drivers:
+        obj = wanted.get(fc.data_path)
+        if obj is None:
+            return False
+        for variable in fc.driver.variables:
+            target = variable.targets[0].id
+            if target is None or (target != obj and target != obj.data):
+                return False
+    return True
 
 
 def light_signature(records):
@@ -344,11 +386,10 @@ def _tables(lut_dir, env):
 def rebuild_rt_lit_groups(scene, lut_dir=None):
     """After a light sync: rebuild every RT Lit group in the file for the scene's lights, then give each material
     the group of the lights that reach it (``cull_lights``)."""
-    rebuilt = []
-    for ng in list(bpy.data.node_groups):
-        if FEATURES_KEY in ng.keys() and ng.name.startswith(RT_LIT_GROUP_PREFIX) and LIGHTS_SUBSET_KEY not in ng:
-            features = Features.from_dict(ng[FEATURES_KEY])
-            rebuilt.append(ensure_rt_lit_group(features, scene, lut_dir))
+    # read first: a rebuild replaces the groups it rebuilds (``node_emit.ensure_tree``)
+    wanted = [Features.from_dict(ng[FEATURES_KEY]) for ng in bpy.data.node_groups
+              if FEATURES_KEY in ng.keys() and ng.name.startswith(RT_LIT_GROUP_PREFIX) and LIGHTS_SUBSET_KEY not in ng]
+    rebuilt = [ensure_rt_lit_group(features, scene, lut_dir) for features in wanted]
     rebuilt += cull_lights(scene, lut_dir)
     return rebuilt
 

@@ -20,7 +20,7 @@ from ..core.ir.expr import FLOAT, Expr, Function, topological_order
 from ..core.ir.semantics import LEAVES
 from ..core.ir.tables import resolve
 from ..core.lut.lookup import LutSet
-from .common import IMAGE_PREFIX, STAMP_KEY, before_rebuild, ensure_interface, socket_by_identifier
+from .common import IMAGE_PREFIX, STAMP_KEY, before_rebuild, ensure_interface, replace_group, socket_by_identifier
 
 #: IR operation -> ShaderNodeMath.operation
 MATH_OPS = {
@@ -420,14 +420,25 @@ def ensure_tree(name, function, interface_inputs, sockets=None, internal_inputs=
     ng = bpy.data.node_groups.get(name)
     if ng is not None and ng.get(STAMP_KEY) == stamp:
         return ng, False
-    if ng is None:
+    in_use = ng
+    if in_use is None:
         ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
     else:
-        before_rebuild(ng)
+        # rebuilt in a copy no tree uses, then swapped in (``replace_group``): each edit of a group in use is
+        # propagated to the trees and materials that use it, which made a 100-light sync take minutes
+        before_rebuild(in_use)
+        ng = in_use.copy()
         ng.nodes.clear()
-    _Emitter(tables).fill(ng, function.outputs, list(interface_inputs), sockets or function.sockets,
-                          internal_inputs=internal_inputs, description=function.description, shader_sums=shader_sums)
+    try:
+        _Emitter(tables).fill(ng, function.outputs, list(interface_inputs), sockets or function.sockets,
+                              internal_inputs=internal_inputs, description=function.description, shader_sums=shader_sums)
+    except BaseException:
+        if in_use is not None:          # the group in use stays as it was
+            bpy.data.node_groups.remove(ng)
+        raise
     ng[STAMP_KEY] = stamp
+    if in_use is not None:
+        replace_group(in_use, ng)
     return ng, True
 
 

@@ -25,19 +25,22 @@ incidence; lobes are per unit of either, cosine included.
 from __future__ import annotations
 
 import functools
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import lights
 from ..ir.expr import FLOAT, VECTOR, define, folding, folding_enabled, table_filter_mode
+from ..ir.functions import NodeFunction
 from ..ir.interface import color
 from ..ir.numpy_backend import evaluate, flat_node_count
 from ..ir.tables import table_names
 from ..lut.lookup import REFERENCES
 from . import light_shading, world_shading
 from .rt_lit_interface import (EMISSION_OUTPUT, GEOMETRY_INPUTS, LIGHT_KINDS, RADIANCE_OUTPUT, RT_LIT_INPUTS,
-                               RT_LIT_OUTPUTS, WORLD_OUTPUT, Features, light_input, light_output, world_input)
+                               RT_LIT_OUTPUTS, SURFACE_OUTPUTS, WORLD_OUTPUT, Features, light_input, light_output,
+                               world_input)
 from .surface import SURFACE
 
 
@@ -57,17 +60,73 @@ def compose(tables, features, material, geometry, lights_in_scene, world=None):
     surface = SURFACE(**{k: material[k] for k in RT_LIT_INPUTS},
                       **{k: geometry[k] for k in ("Geometry Normal", "Incoming")})
     parts = [surface["Emission"]]
-    for kind, params in lights_in_scene:
-        data_fn = lights.light_data(kind)
-        args = dict(params)
-        shading_point = {"Position": geometry["Position"], "Normal": surface["N"]}
-        args.update({k: v for k, v in shading_point.items() if k in data_fn.input_sockets})
-        light = data_fn(**args)
-        parts.append(light_shading.shade_light(tables, kind, features, surface, geometry["Position"], light))
+    parts += _shade_lights(tables, features, surface, geometry["Position"], list(lights_in_scene))
     if world is not None:
         env, params = world
         parts.append(world_shading.shade_world(tables, features, env, surface, params))
     return parts
+
+
+def _shade_light(tables, features, surface, position, kind, params):
+    """Radiance from one scene light of ``kind`` with driver ``params``: its data function, then its shading."""
+    data_fn = lights.light_data(kind)
+    args = dict(params)
+    shading_point = {"Position": position, "Normal": surface["N"]}
+    args.update({k: v for k, v in shading_point.items() if k in data_fn.input_sockets})
+    return light_shading.shade_light(tables, kind, features, surface, position, data_fn(**args))
+
+
+#: A scene with more lights than this shades them in blocks of this many, each block one nested function
+#: ("RTL Lights", ``light_block``).  The values are the same (a block nests the same calls); the node trees are
+#: not: Blender re-validates a whole tree at every node or link an add-on makes, so a flat tree builds in time
+#: quadratic in its size (docs/blender.md, "Node groups"), and a 100-light RT Lit tree took 17 s per engine.
+LIGHT_BLOCK = 8
+
+
+def _shade_lights(tables, features, surface, position, lights_in_scene):
+    """[radiance from each light] of ``lights_in_scene`` [(kind, params)], in blocks when there are many."""
+    if len(lights_in_scene) <= LIGHT_BLOCK:
+        return [_shade_light(tables, features, surface, position, kind, params) for kind, params in lights_in_scene]
+    parts = []
+    for start in range(0, len(lights_in_scene), LIGHT_BLOCK):
+        block = lights_in_scene[start:start + LIGHT_BLOCK]
+        fn = light_block(features, tuple(kind for kind, _ in block))
+        args = {name: surface[name] for name in SURFACE_OUTPUTS}
+        args["Position"] = position
+        args.update({_block_input(j, param): value for j, (_, params) in enumerate(block) for param, value in params.items()})
+        out = fn(tables, **args)
+        parts += [out[_block_output(j)] for j in range(len(block))]
+    return parts
+
+
+def _block_input(j, param):
+    return f"Light {j} {param}"
+
+
+def _block_output(j):
+    return f"Light {j}"
+
+
+@functools.lru_cache(maxsize=None)
+def light_block(features, kinds):
+    """``RTL Lights <n> [<hash>]``: the radiance from ``kinds`` (consecutive scene lights) for ``features``: the
+    surface's outputs, the shading point and each light's driver parameters in, "Light j" out.  Named by a hash of
+    what it shades: blocks of the same kinds share one node group."""
+    inputs = dict(SURFACE_OUTPUTS, Position=GEOMETRY_INPUTS["Position"])
+    for j, kind in enumerate(kinds):
+        inputs.update({_block_input(j, param): lights.light_data(kind).input_sockets[param]
+                       for param in light_parameters(kind)})
+    outputs = {_block_output(j): color((0.0, 0.0, 0.0), f"Radiance from light {j} of the block") for j in range(len(kinds))}
+
+    def body(tables, **kw):
+        surface = {name: kw[name] for name in SURFACE_OUTPUTS}
+        return {_block_output(j): _shade_light(tables, features, surface, kw["Position"], kind,
+                                               {param: kw[_block_input(j, param)] for param in light_parameters(kind)})
+                for j, kind in enumerate(kinds)}
+
+    digest = hashlib.sha1(repr((features, kinds)).encode()).hexdigest()[:8]
+    return NodeFunction(f"RTL Lights {len(kinds)} [{digest}]", body, inputs, outputs,
+                        f"Radiance from {len(kinds)} lights ({', '.join(kinds)}; {features.label()})", tables=REFERENCES)
 
 
 def rt_lit_radiance(tables, features, material, geometry, lights_in_scene, world=None):

@@ -283,9 +283,12 @@ def test_light_sync_benchmark_writes_its_report(bpy_module, tmp_path, lut_dir):
 
     out = tmp_path / "light_sync.md"
     result = light_sync_benchmark.run(light_sync_benchmark.parse_args(
-        ["--objects", "12", "--lights", "3", "--repeats", "5", "--runs", "2", "--lut-dir", str(lut_dir),
-         "--out", str(out)]), log=lambda line: None)
+        ["--objects", "12", "--lights", "3", "--repeats", "5", "--runs", "2", "--sync-lights", "3", "--sync-runs", "1",
+         "--lut-dir", str(lut_dir), "--out", str(out)]), log=lambda line: None)
     assert out.read_text().startswith("# Automatic light sync") and out.with_suffix(".json").is_file()
+    assert "| Sync Lights | 3 lights |" in out.read_text()
+    sync = result["sync_sizes"][0]
+    assert sync["lights"] == 3 and all(sync[key] > 0.0 for key in light_sync_benchmark.SYNC_FIGURES)
     scene = result["scenes"][0]
     assert scene["objects"] == 12 and scene["resync_adding_a_light_ms"] > 0.0
     for ranges in ("without_ranges", "with_ranges"):

@@ -151,3 +151,48 @@ def test_lights_outside_the_render_are_not_shaded(empty_scene):
     assert [o.name for o, _ in scene_lights(scene)] == ["A shown"]
     bpy.context.view_layer.layer_collection.children["Excluded"].exclude = False
     assert [o.name for o, _ in scene_lights(scene)] == ["A shown", "D in an excluded collection"]
+
+
+def test_more_lights_than_a_block_render_like_numpy_and_resync_only_what_changed(empty_scene, lut_dir, tables):
+    """More lights than one block (``core.materials.rt_lit.LIGHT_BLOCK``): the RT Lit trees shade them in nested
+    "RTL Lights" groups and render what numpy computes.  Sync Lights with nothing changed keeps the lights group; a
+    light deleted and another made under its name gets drivers that read the new one, and the render is the same."""
+    import bpy
+
+    from rt_lookdev.addon import light_sync
+    from rt_lookdev.core.materials.rt_lit import LIGHT_BLOCK
+
+    def add_point(i):
+        data = bpy.data.lights.new(f"Extra {i}", "POINT")
+        data.energy, data.shadow_soft_size, data.color = 40.0 + 10.0 * i, 0.0, (1.0, 0.6 + 0.03 * i, 0.4)
+        obj = bpy.data.objects.new(f"Extra {i}", data)
+        obj.location = (2.5 * np.cos(0.7 * i), -2.5, 2.5 * np.sin(0.7 * i))
+        scene.collection.objects.link(obj)
+
+    scene = rt_lit_scene.build(_features()[1:], lut_dir=lut_dir)
+    node = scene.objects["typical"].data.materials[0].node_tree.nodes["RT Lit"]
+    node.inputs["Base Color"].default_value, node.inputs["Roughness"].default_value = (0.2, 0.4, 0.9, 1.0), 0.45
+    extras = LIGHT_BLOCK + 4 - len([o for o in scene.objects if o.type == "LIGHT"])
+    for i in range(extras):
+        add_point(i)
+    light_sync.sync_lights(scene, lut_dir)
+    blocks = {n.node_tree.name for ng in bpy.data.node_groups for n in ng.nodes
+              if n.bl_idname == "ShaderNodeGroup" and n.node_tree is not None and n.node_tree.name.startswith("RTL Lights")}
+    assert len(blocks) >= 2                    # a full block and the rest
+    before, _ = _render_and_compare(scene, tables)
+
+    kept = bpy.data.node_groups["RTL Scene Lights"].session_uid
+    light_sync.sync_lights(scene, lut_dir)
+    assert bpy.data.node_groups["RTL Scene Lights"].session_uid == kept
+
+    bpy.data.objects.remove(scene.objects["Extra 0"])
+    add_point(0)
+    light_sync.sync_lights(scene, lut_dir)
+    lights_group = bpy.data.node_groups["RTL Scene Lights"]
+    assert lights_group.session_uid != kept
+    targets = {v.targets[0].id for fc in lights_group.animation_data.drivers for v in fc.driver.variables}
+    assert None not in targets
+    targets = {t for t in targets if t.name.startswith("Extra 0")}
+    assert targets <= {scene.objects["Extra 0"], scene.objects["Extra 0"].data}
+    after, _ = _render_and_compare(scene, tables)
+    np.testing.assert_allclose(after, before, rtol=0, atol=1e-6)

@@ -133,3 +133,33 @@ def test_power_nodes_have_positive_constant_bases():
     assert powers, "no Power node found: the walk is broken"
     bad = [name for name, base in powers if not (base.is_const and base.attr("value") > 0.0)]
     assert not bad, bad
+
+
+def test_lights_in_blocks_compute_exactly_what_the_flat_sum_computes(monkeypatch, tables):
+    """A material of more lights than ``rt_lit.LIGHT_BLOCK`` shades them in nested "RTL Lights" functions (small node
+    trees, fast to build); its every output is bit for bit the flat material's, in float32."""
+    from rt_lookdev.core.ir.expr import folding_enabled, table_filter_mode, topological_order
+    from rt_lookdev.core.materials import rt_lit
+    from rt_lookdev.core.materials.rt_lit_interface import LIGHT_KINDS, Features
+
+    features = Features("turquin", "cod", sheen=True)
+    kinds = LIGHT_KINDS + ("quad+range", "point+range", "disk+cone", "sphere+range")
+    blocked = rt_lit.build_rt_lit(features, kinds)
+    monkeypatch.setattr(rt_lit, "LIGHT_BLOCK", len(kinds))
+    flat = rt_lit._build.__wrapped__(features, kinds, None, folding_enabled(), table_filter_mode())
+
+    def called(material):
+        return {node.graph.functions[node.attr("function")].name for node in
+                topological_order(list(material.function.outputs.values())) if node.op == "call"}
+    assert sum(name.startswith("RTL Lights") for name in called(blocked)) == 2      # 8 lights, then 5
+    assert not any(name.startswith("RTL Lights") for name in called(flat))
+    rng = np.random.default_rng(7)
+    values = {name: rng.uniform(0.05, 1.0, (256, 3) if kind == "vector" else (256,)).astype(np.float32)
+              for name, kind in blocked.function.inputs}
+    outputs = blocked.part_outputs + ("Radiance",)
+    a = blocked.evaluate(values, tables, outputs=outputs)
+    b = flat.evaluate(values, tables, outputs=outputs)
+    for name in outputs:
+        assert a[name].dtype == np.float32 and np.isfinite(a[name]).all()
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+    assert np.abs(a["Radiance"]).max() > 0.1

@@ -2,6 +2,7 @@
 it shades changed, and what a re-sync costs when something did.
 
     python scripts/benchmark_light_sync.py [--objects 100 1000] [--lights 10] [--repeats 200] [--runs 5]
+                                           [--sync-lights 10 100] [--sync-runs 3]
                                            [--before earlier.json --before-label "..."]
 
 Each scene: ``objects`` objects, of which ``lights`` are lights (quad, disk, point, spot, sun in turn) and the rest
@@ -16,7 +17,10 @@ report's the median of the runs' (with their range):
 - ``update_moving_a_light_ms``: Blender's whole ``view_layer.update()`` after moving a light, with the handler
   registered and without it;
 - ``resync_adding_a_light_ms``: the handler's re-sync when a point light is added (groups rebuilt), and
-  ``snapshot_ms`` the part of it that makes a sync all or nothing (``common.node_groups_kept_on_error``).
+  ``snapshot_ms`` the part of it that makes a sync all or nothing (``common.node_groups_kept_on_error``);
+- ``sync_sizes`` (``--sync-lights``, ``--sync-runs``): Sync Lights on a scene of one RT Lit material and that many
+  point lights: the first sync (every group built), a sync with nothing changed, and one after a light was deleted
+  and another made under its name (its drivers must be made again).
 """
 from __future__ import annotations
 
@@ -180,6 +184,38 @@ def measure(bpy, objects, lights, repeats, lut_dir):
             "node_groups": len(bpy.data.node_groups)}
 
 
+def measure_sync_size(bpy, lights, lut_dir):
+    """One run of Sync Lights (``light_sync.sync_lights``) at ``lights`` point lights: {what: ms}."""
+    from ...addon import compat, light_sync, materials
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = bpy.context.scene
+    mat = compat.new_material("RT Lit")
+    materials.assign_rt_lit(mat, Features(), scene, lut_dir)
+    obj = bpy.data.objects.new("Ball", bpy.data.meshes.new("Ball"))
+    obj.data.materials.append(mat)
+    scene.collection.objects.link(obj)
+    light_sync.sync_lights(scene, lut_dir)
+
+    def add_light(name, i):
+        light = bpy.data.objects.new(name, bpy.data.lights.new(name, "POINT"))
+        light.location = (0.1 * i, 2.0, 3.0)
+        scene.collection.objects.link(light)
+
+    def timed_sync():
+        t = time.perf_counter()
+        light_sync.sync_lights(scene, lut_dir)
+        return round((time.perf_counter() - t) * 1e3, 1)
+
+    for i in range(lights):
+        add_light(f"Light {i:03d}", i)
+    figures = {"first_ms": timed_sync(), "unchanged_ms": timed_sync()}
+    bpy.data.objects.remove(bpy.data.objects["Light 000"])
+    add_light("Light 000", 0)
+    figures["replaced_light_ms"] = timed_sync()
+    return figures
+
+
 def _snapshot_ms(bpy, repeats):
     """What a sync's all-or-nothing costs when it succeeds (``common.node_groups_kept_on_error`` around nothing: the
     add-on's groups copied, then the copies removed); None for code without it."""
@@ -225,8 +261,16 @@ def run(args, log=print):
             log(f"[light sync] {objects} objects, run {i + 1}/{args.runs}: handler with ranges "
                 + ", ".join(f"{name} {ms:.3f} ms" for name, ms in h.items()))
         scenes.append(_median_of_runs(runs))
+    sizes = []
+    for lights in args.sync_lights:
+        runs = []
+        for i in range(args.sync_runs):
+            runs.append(measure_sync_size(bpy, lights, lut_dir))
+            log(f"[light sync] Sync Lights at {lights} lights, run {i + 1}/{args.sync_runs}: "
+                + ", ".join(f"{name} {ms:.0f}" for name, ms in runs[-1].items()))
+        sizes.append({"lights": lights, **_median_of_runs(runs)})
     result = {"lights": args.lights, "repeats": args.repeats, "runs": args.runs, "scenes": scenes,
-              "blender": bpy.app.version_string}
+              "sync_runs": args.sync_runs, "sync_sizes": sizes, "blender": bpy.app.version_string}
     if args.before is not None:
         result["before"] = before_figures(json.loads(args.before.read_text()), args.before_label)
     args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -241,7 +285,8 @@ def before_figures(before, label):
     change: its handler figures per scene, and ``label`` (what the code was)."""
     return {"label": label, "runs": before["runs"], "repeats": before["repeats"],
             "scenes": [{"objects": s["objects"], "handler_ms": s["handler_ms"], "full_check_ms": s["full_check_ms"]}
-                       for s in before["scenes"]]}
+                       for s in before["scenes"]],
+            "sync_runs": before.get("sync_runs"), "sync_sizes": before.get("sync_sizes", [])}
 
 
 def _handler_table(scenes):
@@ -259,6 +304,19 @@ def _ms(scene_figures, key, digits=3):
     return f"{value:.{digits}f} ms ({lo:.{digits}f}-{hi:.{digits}f})"
 
 
+#: The Sync Lights figures (``measure_sync_size``): key -> what the markdown calls it.
+SYNC_FIGURES = {"first_ms": "first sync (every group built)", "unchanged_ms": "again, nothing changed",
+                "replaced_light_ms": "after a light was deleted and another made under its name"}
+
+
+def _sync_size_table(sizes):
+    lines = ["| Sync Lights | " + " | ".join(f"{s['lights']} lights" for s in sizes) + " |",
+             "|---|" + "---|" * len(sizes)]
+    for key, label in SYNC_FIGURES.items():
+        lines.append(f"| {label} | " + " | ".join(_ms(s, key, 0) for s in sizes) + " |")
+    return lines
+
+
 def format_markdown(r):
     lines = [
         "# Automatic light sync: cost per depsgraph update", "",
@@ -268,24 +326,35 @@ def format_markdown(r):
         f"(their range in brackets), each run's the median of {r['repeats']} updates on a scene built anew.", "",
         "The handler's own time per `view_layer.update()`, for updates that change nothing it must act on (with "
         "ranges: every light but the sun has a range reaching every object, so which lights reach which material "
-        "is checked):", "", *_handler_table(r["scenes"])]
-    lines += ["", "| what | " + " | ".join(f"{s['objects']} objects" for s in r["scenes"]) + " |",
-              "|---|" + "---|" * len(r["scenes"])]
-    rows = [("`sync_if_needed(scene)` without a depsgraph (everything checked)", "full_check_ms", "without_ranges", 3),
-            ("the same with ranged lights", "full_check_ms", "with_ranges", 3),
-            ("`view_layer.update()` after moving a light, without the handler", "update_moving_a_light_ms",
-             "without_handler", 3),
-            ("the same with the handler registered", "update_moving_a_light_ms", "with_handler", 3)]
-    for label, group, key, digits in rows:
-        lines.append(f"| {label} | " + " | ".join(_ms(s[group], key, digits) for s in r["scenes"]) + " |")
-    lines.append("| re-sync when a light is added (RT Lit groups rebuilt) | "
-                 + " | ".join(_ms(s, "resync_adding_a_light_ms", 0) for s in r["scenes"]) + " |")
-    if all(s.get("snapshot_ms") is not None for s in r["scenes"]):
-        lines.append("| of which its all-or-nothing: the groups a sync changes copied, and the copies removed (of "
-                     + " and ".join(f"{s['node_groups']}" for s in r["scenes"]) + " node groups in the file) | "
-                     + " | ".join(_ms(s, "snapshot_ms", 1) for s in r["scenes"]) + " |")
+        "is checked):", "", *_handler_table(r["scenes"])] if r["scenes"] else [
+        "# Automatic light sync: cost per depsgraph update", "",
+        "Written by `python scripts/benchmark_light_sync.py` (validation/benchmarks/light_sync_benchmark.py); Blender "
+        f"{r['blender']}, one process.  This run measured Sync Lights only (`--objects` with no sizes)."]
+    if r["scenes"]:
+        lines += ["", "| what | " + " | ".join(f"{s['objects']} objects" for s in r["scenes"]) + " |",
+                  "|---|" + "---|" * len(r["scenes"])]
+        rows = [("`sync_if_needed(scene)` without a depsgraph (everything checked)", "full_check_ms", "without_ranges", 3),
+                ("the same with ranged lights", "full_check_ms", "with_ranges", 3),
+                ("`view_layer.update()` after moving a light, without the handler", "update_moving_a_light_ms",
+                 "without_handler", 3),
+                ("the same with the handler registered", "update_moving_a_light_ms", "with_handler", 3)]
+        for label, group, key, digits in rows:
+            lines.append(f"| {label} | " + " | ".join(_ms(s[group], key, digits) for s in r["scenes"]) + " |")
+        lines.append("| re-sync when a light is added (RT Lit groups rebuilt) | "
+                     + " | ".join(_ms(s, "resync_adding_a_light_ms", 0) for s in r["scenes"]) + " |")
+        if all(s.get("snapshot_ms") is not None for s in r["scenes"]):
+            lines.append("| of which its all-or-nothing: the groups a sync changes copied, and the copies removed (of "
+                         + " and ".join(f"{s['node_groups']}" for s in r["scenes"]) + " node groups in the file) | "
+                         + " | ".join(_ms(s, "snapshot_ms", 1) for s in r["scenes"]) + " |")
+    if r.get("sync_sizes"):
+        lines += ["", f"Sync Lights (`light_sync.sync_lights`) on a scene of one RT Lit material and that many point "
+                      f"lights; the median of {r['sync_runs']} runs (their range), each on a scene built anew:", "",
+                  *_sync_size_table(r["sync_sizes"])]
     before = r.get("before")
-    if before is not None:
+    if before is not None and before.get("sync_sizes"):
+        lines += ["", f"Before: {before['label']} (the same benchmark; medians of {before['sync_runs']} runs):", "",
+                  *_sync_size_table(before["sync_sizes"])]
+    if before is not None and before["scenes"]:
         lines += ["", f"Before: {before['label']} (the same benchmark; medians of {before['runs']} runs of "
                       f"{before['repeats']} updates):", "", *_handler_table(before["scenes"]), "",
                   "| `sync_if_needed(scene)` without a depsgraph | "
@@ -299,7 +368,11 @@ def format_markdown(r):
 
 def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--objects", type=int, nargs="+", default=[100, 1000])
+    p.add_argument("--objects", type=int, nargs="*", default=[100, 1000],
+                   help="scene sizes for the handler's figures (none: only the Sync Lights figures)")
+    p.add_argument("--sync-lights", type=int, nargs="*", default=[10, 100],
+                   help="light counts for the Sync Lights figures (none: skip them)")
+    p.add_argument("--sync-runs", type=int, default=3)
     p.add_argument("--lights", type=int, default=10)
     p.add_argument("--repeats", type=int, default=200)
     p.add_argument("--runs", type=int, default=5)
