@@ -59,6 +59,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -441,7 +442,7 @@ def bake_environment_image(image, name, source, out_dir, settings=PrefilterSetti
             "generator": GENERATOR, "generator_version": GENERATOR_VERSION, "params": json.dumps(sh_params),
             "inputs_hash": sh_hash, "source": source, "source_hash": source_hash})
         coeffs = table[0, :, :3].astype(np.float64)          # the stored (float32) values
-        tmp = sh_json.with_name(sh_json.name + ".tmp")
+        tmp = sh_json.with_name(f"{sh_json.name}.{os.getpid()}.tmp")
         tmp.write_text(json.dumps({"source": source, "source_hash": source_hash, "order": sh_params["order"],
                                    "frame": "image (apply world rotation and strength at use)",
                                    "coefficients_rgb": coeffs.tolist(), "inputs_hash": sh_hash}, indent=1))

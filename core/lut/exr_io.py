@@ -14,6 +14,7 @@ has no OpenEXR module.  Either writer's files read back identically with either 
 from __future__ import annotations
 
 import hashlib
+import os
 from pathlib import Path
 
 import numpy as np
@@ -60,7 +61,8 @@ def write_table(path, table, metadata):
 
 
 def write_tables(items):
-    """Write [(path, (H, W, 4) table, metadata)] all or none: every file goes to ``<name>.tmp`` first and
+    """Write [(path, (H, W, 4) table, metadata)] all or none: every file goes to ``<name>.<pid>.tmp`` first (its own
+    name per process: two processes baking the same table never write into one file) and
     replaces its target only when all are written, so an interrupted or failed write leaves the previous
     files as they were and no partial file.  Returns the content hashes.  ``LutWriteError`` (naming the
     file, the cause and what to do) when a file cannot be written.
@@ -74,7 +76,7 @@ def write_tables(items):
     written = []
     try:
         for path, channels, attributes, _ in prepared:
-            tmp = path.with_name(path.name + ".tmp")
+            tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
             written.append(tmp)
             try:
                 path.parent.mkdir(parents=True, exist_ok=True)
