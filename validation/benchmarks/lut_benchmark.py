@@ -1,6 +1,6 @@
 """Benchmark the energy LUT bake: time, error against sample count, table axis, E_avg fits.
 
-    python scripts/benchmark_luts.py [--out docs/benchmarks] [--repeats 3] [--quick]
+    python scripts/benchmark_luts.py [--out docs/benchmarks] [--repeats 3] [--quick] [--skip-bake]
 
 Writes luts.json (all numbers) and luts.md (tables) to --out.  Measures:
 1. bake time of the ggx_energy group (the three tables come from one pass), median of
@@ -73,20 +73,27 @@ def error_vs_samples(exponents, reference_exponent, stride):
             "cells": int(r.size * mu_eval.size), "mu_min": 0.1, "rows": rows}
 
 
-def interpolation_error(shipped_tables, samples):
+def interpolation_error(shipped_tables, samples, stride=1):
+    """The 64 x 64 table's error at cell centres (every ``stride``-th cell in r and mu), on the shipped mu-linear
+    v axis and on a sqrt(1 - mu) axis (that table baked here, ``samples`` points per node; with a ``stride``, only
+    the nodes around the cells measured)."""
     size = catalog.ENERGY_SIZE
     nodes = np.arange(size) / (size - 1)
     # off-node evaluation points: cell centres in (r, mu)
-    r_mid = (nodes[:-1] + nodes[1:]) / 2
-    mu_mid = (nodes[:-1] + nodes[1:]) / 2
+    r_mid = ((nodes[:-1] + nodes[1:]) / 2)[::stride]
+    mu_mid = ((nodes[:-1] + nodes[1:]) / 2)[::stride]
     mu_mid = mu_mid[mu_mid >= 0.1]
     exact = energy.directional_albedo(mu_mid, r_mid, samples)                     # (r, mu)
     R, M = np.meshgrid(r_mid, mu_mid, indexing="ij")
     mu_linear = 1.0 - semantics.sample_bilinear(shipped_tables["ggx_one_minus_E"],
                                              *lookup.energy_lut_uv(M, R))[..., 0]
-    # the same table on a sqrt(1 - mu) axis
-    v_nodes = nodes
-    e_sqrt = energy.directional_albedo(1.0 - v_nodes ** 2, nodes, samples).T     # (v, r)
+    # the same table on a sqrt(1 - mu) axis: the nodes a bilinear read at the points above touches
+    v_of_points = lookup.lut_coordinate(np.sqrt(1.0 - mu_mid), size) * size - 0.5
+    v_used = np.unique(np.clip(np.concatenate([np.floor(v_of_points), np.floor(v_of_points) + 1]), 0, size - 1))
+    r_used = np.unique(np.clip(np.concatenate([np.arange(size)[::stride], np.arange(size)[::stride] + 1]), 0, size - 1))
+    v_rows, r_cols = v_used.astype(int), r_used.astype(int)
+    e_sqrt = np.zeros((size, size))
+    e_sqrt[np.ix_(v_rows, r_cols)] = energy.directional_albedo(1.0 - nodes[v_rows] ** 2, nodes[r_cols], samples).T
     table_sqrt = np.repeat(e_sqrt[..., None], 4, axis=-1)
     sqrt_axis = semantics.sample_bilinear(table_sqrt, lookup.lut_coordinate(R, size),
                                        lookup.lut_coordinate(np.sqrt(1.0 - M), size))[..., 0]
@@ -96,7 +103,7 @@ def interpolation_error(shipped_tables, samples):
         idx = np.unravel_index(err.argmax(), err.shape)
         out[name] = {"max_abs_err": float(err.max()), "p99_abs_err": float(np.quantile(err, 0.99)),
                      "median_abs_err": float(np.median(err)), "worst_at_r_mu": [float(R[idx]), float(M[idx])]}
-    return {"points": int(R.size), "mu_min": 0.1, "samples": samples, "axes": out}
+    return {"points": int(R.size), "mu_min": 0.1, "samples": samples, "stride": stride, "axes": out}
 
 
 def write_markdown(res, path):
@@ -104,21 +111,27 @@ def write_markdown(res, path):
     lines = [
         "# Energy LUT benchmark", "",
         f"Command: `python scripts/benchmark_luts.py` ({res['machine']}, {res['date']}).", "",
-        "## Bake time", "",
-        f"Group `ggx_energy` ({', '.join(b['tables'])}; one pass, {b['cells']} cells x "
-        f"{b['samples_per_cell']} points): median **{b['median_s']:.1f} s** of {len(b['runs_s'])} runs "
-        f"({', '.join(f'{t:.1f}' for t in b['runs_s'])} s). Writing each EXR file (median): "
-        + ", ".join(f"{n} {1e3 * t:.1f} ms" for n, t in b["write_median_s"].items()) + ".", "",
+        "## Bake time", ""]
+    if b is None:
+        lines += ["Not timed (`--skip-bake`): the tables of the LUT folder.", ""]
+    else:
+        lines += [
+            f"Group `ggx_energy` ({', '.join(b['tables'])}; one pass, {b['cells']} cells x "
+            f"{b['samples_per_cell']} points): median **{b['median_s']:.1f} s** of {len(b['runs_s'])} runs "
+            f"({', '.join(f'{t:.1f}' for t in b['runs_s'])} s). Writing each EXR file (median): "
+            + ", ".join(f"{n} {1e3 * t:.1f} ms" for n, t in b["write_median_s"].items()) + ".", ""]
+    lines += [
         "## Error of E(mu, r) against sample count", "",
         f"Reference: {res['samples']['reference_samples']} points per cell; {res['samples']['cells']} cells "
         f"(every 4th node, mu >= 0.1).", "",
         "| points per cell | max abs err | p99 | mean | ms per cell |", "|---|---|---|---|---|"]
     for row in res["samples"]["rows"]:
-        mark = " (shipped)" if row["samples"] == b["samples_per_cell"] else ""
+        mark = " (shipped)" if row["samples"] == catalog.ENERGY_SAMPLES else ""
         lines.append(f"| {row['samples']}{mark} | {row['max_abs_err']:.2e} | {row['p99_abs_err']:.2e} | "
                      f"{row['mean_abs_err']:.2e} | {row['ms_per_cell']:.2f} |")
     it = res["interpolation"]
-    lines += ["", "## Interpolation error of the 64 x 64 table (off-node points, mu >= 0.1)", "",
+    every = f", every {it['stride']}th cell" if it.get("stride", 1) > 1 else ""
+    lines += ["", f"## Interpolation error of the 64 x 64 table (off-node points, mu >= 0.1{every})", "",
               "| v axis | max abs err | p99 | median | worst at (r, mu) |", "|---|---|---|---|---|"]
     for name, a in it["axes"].items():
         lines.append(f"| {name} | {a['max_abs_err']:.2e} | {a['p99_abs_err']:.2e} | {a['median_abs_err']:.2e} | "
@@ -142,7 +155,9 @@ def parse_args(argv):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks")
     p.add_argument("--repeats", type=int, default=3)
-    p.add_argument("--quick", action="store_true", help="fewer sample counts, smaller reference (smoke run)")
+    p.add_argument("--quick", action="store_true", help="fewer sample counts, smaller reference, the interpolation "
+                   "error on every 4th cell (smoke run)")
+    p.add_argument("--skip-bake", action="store_true", help="do not time the bake: the tables of the LUT folder")
     return p.parse_args(argv)
 
 
@@ -151,14 +166,19 @@ def run(args, log=entry.flush_log):
     args.out.mkdir(parents=True, exist_ok=True)
     res = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
            "date": time.strftime("%Y-%m-%d")}
-    log("[bench] bake time ...")
-    res["bake"], tables = bake_time(1 if args.quick else args.repeats)
-    log(f"[bench]   median {res['bake']['median_s']:.1f} s")
+    if args.skip_bake:
+        res["bake"] = None
+        shipped = lookup.LutSet.from_folder()
+        tables = {name: shipped[name] for name in catalog.GROUPS["ggx_energy"].tables}
+    else:
+        log("[bench] bake time ...")
+        res["bake"], tables = bake_time(1 if args.quick else args.repeats)
+        log(f"[bench]   median {res['bake']['median_s']:.1f} s")
     log("[bench] error vs samples ...")
     exps = [10, 12, 14] if args.quick else [10, 11, 12, 13, 14, 15, 16, 18]
     res["samples"] = error_vs_samples(exps, 16 if args.quick else 20, 8 if args.quick else 4)
     log("[bench] interpolation error ...")
-    res["interpolation"] = interpolation_error(tables, catalog.ENERGY_SAMPLES)
+    res["interpolation"] = interpolation_error(tables, catalog.ENERGY_SAMPLES, 4 if args.quick else 1)
     res["talk_polynomial"] = validation.talk_polynomial_furnace(tables)
     (args.out / "luts.json").write_text(json.dumps(res, indent=2))
     write_markdown(res, args.out / "luts.md")
