@@ -5,18 +5,23 @@
 #   bash scripts/test.sh --release 4.5 [...]  # in the environment of requirements/blender-4.5.lock
 #   bash scripts/test.sh --matrix [...]       # every supported release in turn, then a table of results
 #                                             # (out/matrix/matrix.md and .json)
+#   bash scripts/test.sh --workers 1 [...]    # in one process (default: one pytest-xdist worker per core,
+#                                             # each test module on one worker)
 set -uo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$repo" || exit 1
 
 release=""
 matrix=0
+workers=logical
 args=()
 while (($#)); do
     case "$1" in
         --release) release="${2:?--release needs a name, e.g. 4.5}"; shift 2 ;;
         --release=*) release="${1#--release=}"; shift ;;
         --matrix) matrix=1; shift ;;
+        --workers) workers="${2:?--workers needs a number}"; shift 2 ;;
+        --workers=*) workers="${1#--workers=}"; shift ;;
         *) args+=("$1"); shift ;;
     esac
 done
@@ -47,6 +52,9 @@ run_suite() {  # run_suite <release or ""> <junit xml or ""> [pytest args...]
         done
         extra=()
         [[ -n "$xml" ]] && extra=(--junitxml "$xml")
+        # the suite's tests are mostly one thread each (Python, bpy, one Cycles tile): a worker process per core
+        # (pytest-xdist); a module's tests stay on one worker, so its module fixtures run once
+        [[ "$workers" != 1 ]] && extra+=(-n "$workers" --dist loadscope)
         python -m pytest "${paths[@]}" -q "${extra[@]}" "$@"
         rc=$?
         if [[ -n "$xml" ]]; then   # what the environment is, for the matrix table
