@@ -168,8 +168,8 @@ def run(args, log=entry.flush_log):
            "date": time.strftime("%Y-%m-%d")}
     if args.skip_bake:
         res["bake"] = None
-        shipped = lookup.LutSet.from_folder()
-        tables = {name: shipped[name] for name in catalog.GROUPS["ggx_energy"].tables}
+        tables = {name: exr_io.read_table(catalog.default_lut_dir() / spec.filename)[0]
+                  for name, spec in catalog.TABLES.items() if spec.group == "ggx_energy"}
     else:
         log("[bench] bake time ...")
         res["bake"], tables = bake_time(1 if args.quick else args.repeats)
