@@ -54,6 +54,7 @@ RUN_BY = {
     "scripts/validate_rough_diffuse.py": "here",
     "scripts/measure_sheen_table.py": "here",
     "scripts/benchmark_metal_split.py": "here",
+    "scripts/benchmark_specular_occlusion.py": "here",
 }
 
 #: The commands run here: (script, arguments, files it must write under the output folder).
@@ -75,6 +76,8 @@ SMOKE = {
                                           ["rough_diffuse_furnace.json"]),
     "scripts/measure_sheen_table.py": (["--lut-dir", "{out}"], ["zeltner_sheen.exr", "zeltner_sheen_sh1.exr"]),
     "scripts/benchmark_metal_split.py": (["--quick", "--out", "{out}"], ["metal_split.md", "metal_split.json"]),
+    "scripts/benchmark_specular_occlusion.py": (["--quick", "--out", "{out}"],
+                                                ["specular_occlusion.md", "specular_occlusion.json"]),
 }
 
 
