@@ -6,12 +6,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.lut_benchmark``; ``--help`` li
 import sys
 
 from rt_lookdev.validation.benchmarks import lut_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    args = lut_benchmark.parse_args(argv)
-    lut_benchmark.run(args)
-    return 0
+    return entry.main(lut_benchmark, argv)
 
 
 if __name__ == "__main__":

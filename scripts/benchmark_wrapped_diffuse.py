@@ -7,12 +7,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.wrapped_diffuse_benchmark``; `
 import sys
 
 from rt_lookdev.validation.benchmarks import wrapped_diffuse_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    args = wrapped_diffuse_benchmark.parse_args(argv)
-    wrapped_diffuse_benchmark.run(args.out, args.lights, args.quick, args.lut_dir)
-    return 0
+    return entry.main(wrapped_diffuse_benchmark, argv)
 
 
 if __name__ == "__main__":

@@ -106,7 +106,8 @@ def interpolation_error(shipped_tables, samples, stride=1):
     return {"points": int(R.size), "mu_min": 0.1, "samples": samples, "stride": stride, "axes": out}
 
 
-def write_markdown(res, path):
+def to_markdown(res):
+    """The results as Markdown (luts.md)."""
     b = res["bake"]
     lines = [
         "# Energy LUT benchmark", "",
@@ -147,7 +148,7 @@ def write_markdown(res, path):
         lines.append(f"| {row['r']:.3f} | {row['max_err_mu_ge_0.1']:.4f} | {row['err_at_grazing_mu']:+.4f} |")
     lines += ["", "With E_avg from the table itself the identity holds to rounding "
               "(tests/core/test_multiscatter.py::test_kulla_conty_white_furnace).", ""]
-    path.write_text("\n".join(lines))
+    return "\n".join(lines)
 
 
 def parse_args(argv):
@@ -161,7 +162,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(args, log=entry.flush_log):
+def run(args, progress=entry.flush_log):
     """Measure, write luts.json and luts.md to ``args.out``; returns the results."""
     args.out.mkdir(parents=True, exist_ok=True)
     res = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
@@ -171,16 +172,17 @@ def run(args, log=entry.flush_log):
         tables = {name: exr_io.read_table(catalog.default_lut_dir() / spec.filename)[0]
                   for name, spec in catalog.TABLES.items() if spec.group == "ggx_energy"}
     else:
-        log("[bench] bake time ...")
+        progress("[bench] bake time ...")
         res["bake"], tables = bake_time(1 if args.quick else args.repeats)
-        log(f"[bench]   median {res['bake']['median_s']:.1f} s")
-    log("[bench] error vs samples ...")
+        progress(f"[bench]   median {res['bake']['median_s']:.1f} s")
+    progress("[bench] error vs samples ...")
     exps = [10, 12, 14] if args.quick else [10, 11, 12, 13, 14, 15, 16, 18]
     res["samples"] = error_vs_samples(exps, 16 if args.quick else 20, 8 if args.quick else 4)
-    log("[bench] interpolation error ...")
+    progress("[bench] interpolation error ...")
     res["interpolation"] = interpolation_error(tables, catalog.ENERGY_SAMPLES, 4 if args.quick else 1)
     res["talk_polynomial"] = validation.talk_polynomial_furnace(tables)
     (args.out / "luts.json").write_text(json.dumps(res, indent=2))
-    write_markdown(res, args.out / "luts.md")
-    log((args.out / "luts.md").read_text())
+    markdown = to_markdown(res)
+    (args.out / "luts.md").write_text(markdown)
+    progress(markdown)
     return res

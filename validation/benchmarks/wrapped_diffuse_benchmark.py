@@ -22,11 +22,11 @@ import time
 
 import numpy as np
 
-from ..harness import outputs
+from ..harness import entry, outputs
 from ...core import diffuse
 from ...core import indirect
 from ...core.conventions import alpha_from_roughness
-from ...core.ltc import shading
+from ...core.ltc import reference, shading
 from ...core.lut import lookup
 from ...core.lut.catalog import default_lut_dir
 
@@ -59,8 +59,6 @@ def random_light(rng, kind, wrap):
 
 def area_row(tables, kind, wrap, roughness, lights, seed):
     """Relative errors of the shipped area form and the talk's against the lobe's integral over ``lights`` lights."""
-    from ...core.ltc import reference, shading
-
     rng = np.random.default_rng(seed)
     n, p = np.array([0.0, 0.0, 1.0]), np.zeros(3)
     alpha = alpha_from_roughness(roughness)
@@ -123,8 +121,6 @@ def sh_rows(tables, points, seed):
 
 def albedo_rows(views=6):
     """The punctual lobe's directional albedo at w = 0.5 and 1 against w = 0 (the CoD lobe's)."""
-    from ...core import diffuse, indirect
-
     rng = np.random.default_rng(1)
     n = np.tile([0.0, 0.0, 1.0], (views, 1))
     v = _unit(np.concatenate([rng.normal(size=(views, 2)), rng.uniform(0.1, 1.0, (views, 1))], -1))
@@ -139,7 +135,8 @@ def albedo_rows(views=6):
     return rows
 
 
-def markdown(result):
+def to_markdown(result):
+    """The result as Markdown (wrapped_diffuse.md)."""
     L = ["# Multiscattering wrapped diffuse: measured", "",
          "`python scripts/benchmark_wrapped_diffuse.py` (validation/benchmarks/wrapped_diffuse_benchmark.py; numpy, "
          f"{result['seconds']:.0f} s on this machine). The lobe, f_CoD(l_w, v) mu_w / (1 + w) with l_w the wrapped "
@@ -170,20 +167,20 @@ def markdown(result):
     return "\n".join(L) + "\n"
 
 
-def run(out=None, lights=120, quick=False, lut_dir=None, log=print):
+def run(args, progress=entry.flush_log):
+    """Measure the three parts with ``args``' options; writes wrapped_diffuse.md and .json in ``args.out``."""
     t0 = time.perf_counter()
-    tables = lookup.LutSet.from_folder(lut_dir or default_lut_dir())
-    if quick:
-        lights = min(lights, 12)
+    tables = lookup.LutSet.from_folder(args.lut_dir or default_lut_dir())
+    lights = min(args.lights, 12) if args.quick else args.lights
     area = [area_row(tables, kind, w, r, lights, seed=100 * i + j)
             for i, kind in enumerate(("quad", "disk")) for j, (w, r) in
-            enumerate([(w, r) for w in (WRAPS[-1:] if quick else WRAPS) for r in ROUGHNESS])]
-    result = {"lights": lights, "quick": quick, "area": area, "sh": sh_rows(tables, 60 if quick else 300, seed=1),
-              "albedo": albedo_rows(2 if quick else 6)}
+            enumerate([(w, r) for w in (WRAPS[-1:] if args.quick else WRAPS) for r in ROUGHNESS])]
+    result = {"lights": lights, "quick": args.quick, "area": area,
+              "sh": sh_rows(tables, 60 if args.quick else 300, seed=1), "albedo": albedo_rows(2 if args.quick else 6)}
     result["seconds"] = time.perf_counter() - t0
-    md = markdown(result)
-    outputs.write_results(out, "wrapped_diffuse", result, md)
-    log(md)
+    md = to_markdown(result)
+    outputs.write_results(args.out, "wrapped_diffuse", result, md)
+    progress(md)
     return result
 
 
