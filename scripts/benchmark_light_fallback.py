@@ -7,12 +7,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.light_fallback_benchmark``; ``
 import sys
 
 from rt_lookdev.validation.benchmarks import light_fallback_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    args = light_fallback_benchmark.parse_args(argv)
-    light_fallback_benchmark.run(args.out, args.quick, args.lut_dir)
-    return 0
+    return entry.main(light_fallback_benchmark, argv)
 
 
 if __name__ == "__main__":

@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from ..harness import outputs
+from ..harness import entry, outputs
 from ...core import lights
 from ...core.ir.expr import table_filter
 from ...core.ir.numpy_backend import flat_node_count
@@ -98,8 +98,6 @@ def talk_readings(pos, params, albedo=1.0):
 
 def costs():
     """Operations of one light in the Cycles tree (Linear table reads) for each way of shading a quad."""
-    from ...core.materials.rt_lit_interface import Features
-
     out = {}
     with table_filter("linear"):
         for label, features in (("Turquin + CoD", Features()), ("single + Lambert", Features("single", "lambert"))):
@@ -112,14 +110,16 @@ def costs():
     return out
 
 
-def run(out=None, quick=False, lut_dir=None, log=print):
+def run(args, progress=entry.flush_log):
+    """Measure every shape, height and angle pair, and the costs; writes light_fallback.md and .json in
+    ``args.out``."""
     t0 = time.perf_counter()
-    tables = lookup.LutSet.from_folder(lut_dir or default_lut_dir())
+    tables = lookup.LutSet.from_folder(args.lut_dir or default_lut_dir())
     rows = []
     for shape, (sx, sy) in SHAPES.items():
         diameter = float(area_light_diameter(1.0, 1.0, sx, sy, "quad"))
         for height in HEIGHTS:
-            pos, view = _floor(31 if quick else 81, height)
+            pos, view = _floor(31 if args.quick else 81, height)
             for outer, inner in ANGLE_PAIRS:
                 params = _light_params(sx, sy, outer, inner, height)
                 quads, spots = [], []
@@ -133,11 +133,11 @@ def run(out=None, quick=False, lut_dir=None, log=print):
                              "shipped": _errors(np.concatenate(quads, 1), np.concatenate(spots, 1)),
                              "materials": {name: _errors(q, sp) for name, q, sp in zip(MATERIALS, quads, spots)},
                              "talk": {name: _errors(lambert, v) for name, v in talk_readings(pos, params).items()}})
-    result = {"quick": quick, "rows": rows, "costs": costs()}
+    result = {"quick": args.quick, "rows": rows, "costs": costs()}
     result["seconds"] = time.perf_counter() - t0
-    md = markdown(result)
-    outputs.write_results(out, "light_fallback", result, md)
-    log(md)
+    md = to_markdown(result)
+    outputs.write_results(args.out, "light_fallback", result, md)
+    progress(md)
     return result
 
 
@@ -145,7 +145,8 @@ def _cell(s):
     return f"{s['median']:.1%} / {s['p90']:.1%}"
 
 
-def markdown(result):
+def to_markdown(result):
+    """The result as Markdown (light_fallback.md)."""
     talk = list(result["rows"][0]["talk"])
     L = ["# Light controls: the quad-to-spot fallback against the quad, and what the controls cost", "",
          f"`python scripts/benchmark_light_fallback.py` (validation/benchmarks/light_fallback_benchmark.py; numpy, "
