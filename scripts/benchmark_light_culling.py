@@ -7,13 +7,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.light_culling_benchmark``; ``-
 import sys
 
 from rt_lookdev.validation.benchmarks import light_culling_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    args = light_culling_benchmark.parse_args(argv)
-    light_culling_benchmark.run(args.out, args.repeats, args.quick, args.lut_dir,
-                                tuple(s for s in args.scenes.split(",") if s))
-    return 0
+    return entry.main(light_culling_benchmark, argv)
 
 
 if __name__ == "__main__":

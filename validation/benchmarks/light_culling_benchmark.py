@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from ..harness import outputs, scene_render
+from ..harness import entry, outputs, scene_render
 from ...core.materials.rt_lit_interface import Features
 
 
@@ -153,27 +153,30 @@ SCENES = {"demo": ("demo scene, ranges to its centre", demo_scene),
           "grid": ("16 point lights, 4 x 4 spheres, 5 m ranges", grid_scene)}
 
 
-def run(out=None, repeats=3, quick=False, lut_dir=None, scenes=("demo", "grid"), log=print):
+def run(args, progress=entry.flush_log):
+    """Measure the scenes of ``args.scenes``; writes light_culling.md and .json in ``args.out``."""
     t0 = time.perf_counter()
+    quick, lut_dir = args.quick, args.lut_dir
     resolution = 96 if quick else 256
-    repeats = 1 if quick else repeats
+    repeats = 1 if quick else args.repeats
     result = {"repeats": repeats, "resolution": resolution, "quick": quick, "scenes": {}}
-    for key in scenes:
+    for key in (s for s in args.scenes.split(",") if s):
         name, build = SCENES[key]
         if quick and key == "grid":       # a 2 x 2 grid: the same code, seconds
             name, build = "4 point lights, 2 x 2 spheres, 5 m ranges", lambda d, r: grid_scene(d, r, 2, 2)
         scene = build(lut_dir, resolution)
         result["scenes"][name] = measure(scene, lut_dir, resolution, repeats, 1 if quick else 2)
-        log(f"[culling] {name}: nodes {result['scenes'][name]['node_ratio_total']:.2f}x fewer, render "
+        progress(f"[culling] {name}: nodes {result['scenes'][name]['node_ratio_total']:.2f}x fewer, render "
             f"{result['scenes'][name]['speedup']:.2f}x faster")
     result["seconds"] = time.perf_counter() - t0
-    md = markdown(result)
-    outputs.write_results(out, "light_culling", result, md)
-    log(md)
+    md = to_markdown(result)
+    outputs.write_results(args.out, "light_culling", result, md)
+    progress(md)
     return result
 
 
-def markdown(result):
+def to_markdown(result):
+    """The result as Markdown (light_culling.md)."""
     L = ["# Lights out of range, left out of each material's tree", "",
          f"`python scripts/benchmark_light_culling.py` (validation/benchmarks/light_culling_benchmark.py; {result['seconds']:.0f} s "
          f"on 2 cores). Cycles, 1 sample, {result['resolution']}^2; every light has a range in both columns (the "
