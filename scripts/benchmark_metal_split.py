@@ -7,15 +7,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.metal_split_benchmark``; ``--h
 import sys
 
 from rt_lookdev.validation.benchmarks import metal_split_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    args = metal_split_benchmark.parse_args(argv)
-    if args.measure:   # the child process of one shading
-        metal_split_benchmark.measure(args.measure, args.cases, args.work)
-        return 0
-    metal_split_benchmark.run(args.out, args.quick)
-    return 0
+    return entry.main(metal_split_benchmark, argv)
 
 
 if __name__ == "__main__":

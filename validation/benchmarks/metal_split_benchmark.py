@@ -40,10 +40,10 @@ def measure(shading, cases, work):
     return suite.run(args)
 
 
-def _run_child(shading, cases, work, log):
+def _run_child(shading, cases, work, progress):
     cmd = [sys.executable, str(REPO / "scripts" / "benchmark_metal_split.py"), "--measure", shading,
            "--work", str(work), "--cases", *cases]
-    log(f"[metal_split] {shading}: {' '.join(cases)}")
+    progress(f"[metal_split] {shading}: {' '.join(cases)}")
     proc = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True)
     if proc.returncode != 0:
         raise RuntimeError(f"the suite run ({shading}) failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
@@ -65,7 +65,8 @@ def _pairs(result, part, key):
     return dict(sorted(rows.items()))
 
 
-def markdown(result):
+def to_markdown(result):
+    """The result of the benchmark (not of a ``--measure`` child) as Markdown (metal_split.md)."""
     L = ["# Metal and dielectric apart: Metallic 0.5 against Cycles", "",
          f"`python scripts/benchmark_metal_split.py{' --quick' if result['quick'] else ''}` "
          f"(validation/benchmarks/metal_split_benchmark.py; {result['seconds']:.0f} s on 2 cores). The validation suite's "
@@ -91,17 +92,23 @@ def markdown(result):
     return "\n".join(L) + "\n"
 
 
-def run(out=None, quick=False, log=entry.flush_log):
+def run(args, progress=entry.flush_log):
+    """Both shadings' suite runs, each a child process, compared; writes metal_split.md and .json in ``args.out``.
+    With ``--measure`` (the child process's part): the suite's ``--cases`` with that shading, its files in
+    ``--work``; returns what was run (no "passed": the child's exit code is 0 whatever the suite's gates say)."""
+    if args.measure:
+        measure(args.measure, args.cases, args.work)
+        return {"measure": args.measure, "cases": list(args.cases), "work": args.work}
     t0 = time.perf_counter()
-    cases = QUICK_CASES if quick else CASES
-    result = {"quick": quick, "cases": list(cases)}
+    cases = QUICK_CASES if args.quick else CASES
+    result = {"quick": args.quick, "cases": list(cases)}
     with tempfile.TemporaryDirectory(prefix="rtl-metal-split-") as tmp:
         for shading in SHADINGS:
-            result[shading] = _run_child(shading, cases, Path(tmp) / shading, log)
+            result[shading] = _run_child(shading, cases, Path(tmp) / shading, progress)
     result["seconds"] = time.perf_counter() - t0
-    md = markdown(result)
-    outputs.write_results(out, "metal_split", result, md)
-    log(md)
+    md = to_markdown(result)
+    outputs.write_results(args.out, "metal_split", result, md)
+    progress(md)
     return result
 
 
