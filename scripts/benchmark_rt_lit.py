@@ -6,12 +6,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.rt_lit_benchmark``; ``--help``
 import sys
 
 from rt_lookdev.validation.benchmarks import rt_lit_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    args = rt_lit_benchmark.parse_args(argv)
-    rt_lit_benchmark.run(args)
-    return 0
+    return entry.main(rt_lit_benchmark, argv)
 
 
 if __name__ == "__main__":

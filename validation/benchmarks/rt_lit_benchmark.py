@@ -396,7 +396,7 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def run(args, log=entry.flush_log):
+def run(args, progress=entry.flush_log):
     """Measure every feature set, write rt_lit.json and rt_lit.md to ``args.out``; returns the JSON's dict."""
     quick = getattr(args, "quick", False)
     reps = 1 if quick else args.repeats
@@ -405,17 +405,25 @@ def run(args, log=entry.flush_log):
     t_start = time.perf_counter()
     for features in feature_sets(args.only or (["single, lambert"] if quick else None)):
         rows.append(measure(features, reps, max_lights))
-        log(str(rows[-1]))
+        progress(str(rows[-1]))
     total = round(time.perf_counter() - t_start, 1)
     args.out.mkdir(parents=True, exist_ok=True)
     result = {"resolution": list(RESOLUTION), "samples": 1, "repeats": reps, "hdri": HDRI,
               "world_strength": WORLD_STRENGTH, "max_lights": max_lights, "total_seconds": total,
               "cycles_threads": _threads(), "rows": rows}
     (args.out / "rt_lit.json").write_text(json.dumps(result, indent=2))
-    lines = _markdown_capacity(rows, reps) + _markdown_world_time(rows) + _markdown_node_counts(rows, total)
-    (args.out / "rt_lit.md").write_text("\n".join(lines) + "\n")
-    log("\n".join(lines))
+    markdown = to_markdown(result)
+    (args.out / "rt_lit.md").write_text(markdown)
+    progress(markdown.removesuffix("\n"))
     return result
+
+
+def to_markdown(result):
+    """The result as Markdown (rt_lit.md)."""
+    rows = result["rows"]
+    lines = (_markdown_capacity(rows, result["repeats"]) + _markdown_world_time(rows)
+             + _markdown_node_counts(rows, result["total_seconds"]))
+    return "\n".join(lines) + "\n"
 
 
 def _threads():
