@@ -6,12 +6,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.environment_benchmark``; ``--h
 import sys
 
 from rt_lookdev.validation.benchmarks import environment_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    args = environment_benchmark.parse_args(argv)
-    environment_benchmark.run(args)
-    return 0
+    return entry.main(environment_benchmark, argv)
 
 
 if __name__ == "__main__":
