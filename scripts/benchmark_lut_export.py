@@ -7,11 +7,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.lut_export_benchmark``; ``--he
 import sys
 
 from rt_lookdev.validation.benchmarks import lut_export_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    lut_export_benchmark.run(lut_export_benchmark.parse_args(argv))
-    return 0
+    return entry.main(lut_export_benchmark, argv)
 
 
 if __name__ == "__main__":

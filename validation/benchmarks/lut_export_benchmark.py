@@ -66,7 +66,8 @@ def furnaces(arrays, reference):
             "fdez_aguera_rel_change": float(np.max(np.abs(f - f0) / np.abs(f0)))}
 
 
-def run(args, log=entry.flush_log):
+def run(args, progress=entry.flush_log):
+    """Measure the three variants; writes ``args.out`` (Markdown) and the JSON beside it."""
     lut_dir = args.lut_dir or catalog.default_lut_dir()
     t0 = time.perf_counter()
     tables = luts.layout_tables(LutSet.from_folder(lut_dir), "rtl")
@@ -75,7 +76,7 @@ def run(args, log=entry.flush_log):
     result = {"date": time.strftime("%Y-%m-%d"), "quads": args.quads, "disks": args.disks, "per_table": per_table,
               "end_to_end": {}, "furnaces": {}}
     for variant, arrays in variants.items():
-        log(f"[lut export] {variant}: LTC light set, furnaces")
+        progress(f"[lut export] {variant}: LTC light set, furnaces")
         ltc = {n: a for n, a in arrays.items() if n.startswith("ltc_")}
         result["end_to_end"][variant] = ltc_random_lights.end_to_end(ltc, None, args.quads, args.disks)
         result["furnaces"][variant] = furnaces(arrays, variants["f32"])
@@ -83,12 +84,13 @@ def run(args, log=entry.flush_log):
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.with_suffix(".json").write_text(json.dumps(result, indent=1))
-    out.write_text(format_markdown(result))
-    log(f"wrote {out} and {out.with_suffix('.json')}")
+    out.write_text(to_markdown(result))
+    progress(f"wrote {out} and {out.with_suffix('.json')}")
     return result
 
 
-def format_markdown(result):
+def to_markdown(result):
+    """The result as Markdown (lut_export.md)."""
     lines = ["# Half-precision LUTs: per table and end to end", "",
              f"Measured {result['date']} with `python scripts/benchmark_lut_export.py` "
              f"({result['seconds']:.0f} s). Half as is: every value rounded to float16; half scaled: as "
