@@ -6,11 +6,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.light_sync_benchmark``; ``--he
 import sys
 
 from rt_lookdev.validation.benchmarks import light_sync_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    light_sync_benchmark.run(light_sync_benchmark.parse_args(argv))
-    return 0
+    return entry.main(light_sync_benchmark, argv)
 
 
 if __name__ == "__main__":

@@ -280,11 +280,12 @@ def test_lights_stay_in_sync_without_a_button(registered, empty_scene, lut_dir):
 def test_light_sync_benchmark_writes_its_report(bpy_module, tmp_path, lut_dir):
     """The README's `python scripts/benchmark_light_sync.py` (small here): report and JSON written."""
     from rt_lookdev.validation.benchmarks import light_sync_benchmark
+    from rt_lookdev.validation.harness import entry
 
     out = tmp_path / "light_sync.md"
     result = light_sync_benchmark.run(light_sync_benchmark.parse_args(
         ["--objects", "12", "--lights", "3", "--repeats", "5", "--runs", "2", "--sync-lights", "3", "--sync-runs", "1",
-         "--lut-dir", str(lut_dir), "--out", str(out)]), log=lambda line: None)
+         "--lut-dir", str(lut_dir), "--out", str(out)]), progress=entry.quiet)
     assert out.read_text().startswith("# Automatic light sync") and out.with_suffix(".json").is_file()
     assert "| Sync Lights | 3 lights |" in out.read_text()
     sync = result["sync_sizes"][0]

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from ...core.lut import catalog
 from ...core.materials.rt_lit_interface import Features
+from ..harness import entry
 
 REPO = Path(__file__).resolve().parents[2]
 KINDS = (("AREA", "SQUARE"), ("AREA", "DISK"), ("POINT", None), ("SPOT", None), ("SUN", None))
@@ -247,9 +248,10 @@ def _median_of_runs(runs):
     return out
 
 
-def run(args, log=print):
+def run(args, progress=entry.flush_log):
+    """Measure the scenes of ``args.objects`` and the Sync Lights sizes; writes ``args.out`` (Markdown) and the JSON
+    beside it."""
     import bpy
-
 
     lut_dir = args.lut_dir or catalog.default_lut_dir()
     scenes = []
@@ -258,7 +260,7 @@ def run(args, log=print):
         for i in range(args.runs):
             runs.append(measure(bpy, objects, args.lights, args.repeats, lut_dir))
             h = runs[-1]["handler_ms"]["with_ranges"]
-            log(f"[light sync] {objects} objects, run {i + 1}/{args.runs}: handler with ranges "
+            progress(f"[light sync] {objects} objects, run {i + 1}/{args.runs}: handler with ranges "
                 + ", ".join(f"{name} {ms:.3f} ms" for name, ms in h.items()))
         scenes.append(_median_of_runs(runs))
     sizes = []
@@ -266,7 +268,7 @@ def run(args, log=print):
         runs = []
         for i in range(args.sync_runs):
             runs.append(measure_sync_size(bpy, lights, lut_dir))
-            log(f"[light sync] Sync Lights at {lights} lights, run {i + 1}/{args.sync_runs}: "
+            progress(f"[light sync] Sync Lights at {lights} lights, run {i + 1}/{args.sync_runs}: "
                 + ", ".join(f"{name} {ms:.0f}" for name, ms in runs[-1].items()))
         sizes.append({"lights": lights, **_median_of_runs(runs)})
     result = {"lights": args.lights, "repeats": args.repeats, "runs": args.runs, "scenes": scenes,
@@ -275,8 +277,8 @@ def run(args, log=print):
         result["before"] = before_figures(json.loads(args.before.read_text()), args.before_label)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.with_suffix(".json").write_text(json.dumps(result, indent=1) + "\n")
-    args.out.write_text(format_markdown(result))
-    log(f"[light sync] -> {args.out}")
+    args.out.write_text(to_markdown(result))
+    progress(f"[light sync] -> {args.out}")
     return result
 
 
@@ -317,7 +319,8 @@ def _sync_size_table(sizes):
     return lines
 
 
-def format_markdown(r):
+def to_markdown(r):
+    """The result as Markdown (light_sync.md)."""
     lines = [
         "# Automatic light sync: cost per depsgraph update", "",
         "Written by `python scripts/benchmark_light_sync.py` (validation/benchmarks/light_sync_benchmark.py).  Each scene: "
