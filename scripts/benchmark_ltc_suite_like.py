@@ -7,11 +7,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.ltc_suite_like``; ``--help`` l
 import sys
 
 from rt_lookdev.validation.benchmarks import ltc_suite_like
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    ltc_suite_like.run(ltc_suite_like.parse_args(argv))
-    return 0
+    return entry.main(ltc_suite_like, argv)
 
 
 if __name__ == "__main__":

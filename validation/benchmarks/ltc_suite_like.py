@@ -19,8 +19,13 @@ the error can be reported per roughness band and per light kind.
 """
 from __future__ import annotations
 
+import argparse
 import hashlib
 import json
+import os
+import platform
+import subprocess
+import tempfile
 import time
 from pathlib import Path
 
@@ -30,6 +35,7 @@ from ...core.ltc import fit_lobes, shading
 from ...core.lut import catalog, lookup
 from ..checks import suite_cases
 from ..checks import suite_brute_force
+from ..harness import entry, outputs
 
 #: Roughness values measured at every sphere.
 ROUGHNESS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
@@ -167,7 +173,8 @@ def ltc_lobe(tables, entry, roughness=ROUGHNESS, dtype=np.float64):
     return np.stack(cols, axis=-1)
 
 
-def truth_cached(entries, roughness=ROUGHNESS, panels=(4, 8, 16, 32, 64), order=8, cache_dir=None, log=print):
+def truth_cached(entries, roughness=ROUGHNESS, panels=(4, 8, 16, 32, 64), order=8, cache_dir=None,
+                 progress=entry.flush_log):
     """``brute_force`` of every entry, cached in ``cache_dir`` by a hash of the geometry and the rule."""
     results = []
     for e in entries:
@@ -183,7 +190,7 @@ def truth_cached(entries, roughness=ROUGHNESS, panels=(4, 8, 16, 32, 64), order=
             continue
         t0 = time.perf_counter()
         truth, err = brute_force(e, roughness, panels, order)
-        log(f"[suite-like] {e['case']}: {len(e['P'])} points x {len(roughness)} r in {time.perf_counter() - t0:.1f} s")
+        progress(f"[suite-like] {e['case']}: {len(e['P'])} points x {len(roughness)} r in {time.perf_counter() - t0:.1f} s")
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
             np.savez(path, truth=truth, error=err)
@@ -234,10 +241,10 @@ def report(values, roughness=ROUGHNESS, bands=BANDS):
     return out
 
 
-def measure(tables, entries=None, truths=None, cache_dir=None, log=print):
+def measure(tables, entries=None, truths=None, cache_dir=None, progress=entry.flush_log):
     """Everything above for one table set: (report, values)."""
     entries = entries if entries is not None else build_set()
-    truths = truths if truths is not None else truth_cached(entries, cache_dir=cache_dir, log=log)
+    truths = truths if truths is not None else truth_cached(entries, cache_dir=cache_dir, progress=progress)
     estimates = [ltc_lobe(tables, e) for e in entries]
     values = gather(entries, truths, estimates)
     return report(values), values
@@ -269,8 +276,6 @@ BEFORE = "a8bb34f"
 
 def tables_at_revision(rev, folder):
     """The catalog's tables as committed at git revision ``rev``, written to ``folder``: a LutSet."""
-    import subprocess
-
     repo = Path(__file__).resolve().parents[2]
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -282,8 +287,6 @@ def tables_at_revision(rev, folder):
 
 
 def parse_args(argv):
-    import argparse
-
     p = argparse.ArgumentParser(description="The GGX LTC's error on a suite-like set, two table sets compared")
     p.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[2] / "docs" / "benchmarks")
     p.add_argument("--lut-dir", type=Path, default=None, help="the tables measured (default: the shipped luts/)")
@@ -295,7 +298,8 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
-def _markdown(res):
+def to_markdown(res):
+    """The result as Markdown (ltc_suite_like.md)."""
     lines = ["# The GGX LTC on a suite-like set", "",
              f"Command: `python scripts/benchmark_ltc_suite_like.py` ({res['machine']}, {res['date']}; "
              f"{res['seconds']:.0f} s, brute force cached in `--cache`). Module: `validation/benchmarks/ltc_suite_like.py`.", "",
@@ -325,15 +329,11 @@ def _markdown(res):
     return "\n".join(lines)
 
 
-def run(args, log=print):
+def run(args, progress=entry.flush_log):
     """Measure the tables of ``args.lut_dir`` and of revision ``args.before``; write ltc_suite_like.{json,md}."""
-    import os
-    import platform
-    import tempfile
-
     t0 = time.perf_counter()
     entries = build_set(args.seed, args.cell, args.pixels)
-    truths = truth_cached(entries, cache_dir=args.cache, log=log)
+    truths = truth_cached(entries, cache_dir=args.cache, progress=progress)
     after = lookup.LutSet.from_folder(args.lut_dir)
     with tempfile.TemporaryDirectory(prefix="rtl-luts-before-") as tmp:
         before = tables_at_revision(args.before, tmp)
@@ -343,8 +343,7 @@ def run(args, log=print):
            "before": args.before, "after": str(args.lut_dir or "luts/ of this checkout"), "roughness": list(ROUGHNESS),
            "floor": FLOOR, "pixels": args.pixels, "cell": args.cell, "points": int(sum(len(e["P"]) for e in entries)),
            "before_report": before_report, "after_report": after_report, "seconds": time.perf_counter() - t0}
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "ltc_suite_like.json").write_text(json.dumps(res, indent=1))
-    (args.out / "ltc_suite_like.md").write_text(_markdown(res))
-    log(_markdown(res))
+    markdown = to_markdown(res)
+    outputs.write_results(args.out, "ltc_suite_like", res, markdown)
+    progress(markdown)
     return res
