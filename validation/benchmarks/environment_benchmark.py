@@ -203,8 +203,8 @@ def _markdown_hdris(result, settings):
           "| HDRI | SH irradiance mean rel | p90 | max | SH bake (s) | prefiltered bake (s) | cached re-run (s) |",
           "|---|---|---|---|---|---|---|"]
     for h in result["hdris"]:
-        md.append(f"| {h['name']} | {h['sh_irradiance_mean']:.4f} | {h['p90']:.4f} | {h['max']:.4f} | {h['sh_s']:.2f} | "
-                  f"{h['prefiltered_s']:.2f} | {h['cached_s']:.3f} |")
+        md.append(f"| {h['name']} | {h['sh_irradiance_mean']:.4f} | {h['p90']:.4f} | {h['max']:.4f} | "
+                  f"{h['sh_s']:.2f} | {h['prefiltered_s']:.2f} | {h['cached_s']:.3f} |")
     md += ["", "The max relative differences occur where the irradiance is small (normals facing dark ground "
            "or a dark sky side): nine coefficients cannot follow a sharp bright/dark horizon, and a small bright sun (sunrise, studio) makes the L2 irradiance ring (max > 1: the SH value overshoots, or goes below zero, opposite the sun).", ""]
     return md

@@ -190,7 +190,8 @@ def truth_cached(entries, roughness=ROUGHNESS, panels=(4, 8, 16, 32, 64), order=
             continue
         t0 = time.perf_counter()
         truth, err = brute_force(e, roughness, panels, order)
-        progress(f"[suite-like] {e['case']}: {len(e['P'])} points x {len(roughness)} r in {time.perf_counter() - t0:.1f} s")
+        progress(f"[suite-like] {e['case']}: {len(e['P'])} points x {len(roughness)} r in "
+                 f"{time.perf_counter() - t0:.1f} s")
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
             np.savez(path, truth=truth, error=err)
