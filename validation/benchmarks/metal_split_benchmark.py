@@ -33,10 +33,11 @@ CASES, QUICK_CASES = ("metallic_mix_quad", "metallic_mix_disk", "metallic_mix_po
 
 
 def measure(shading, cases, work):
-    """Run in the child process: the suite's ``cases`` with ``shading``; its results land in ``work``."""
+    """Run in the child process: the suite's ``cases`` with ``shading``; its results land in ``work``.  The cases run
+    in this process (``--workers 0``): the shading is set here, and a Dask worker's process would not see it."""
     if shading == "mixed_f0":
         light_shading.SPLIT_F0_MODELS = ()
-    args = suite.parse_args(["--cases", *cases, "--out", str(work), "--skip-furnace"])
+    args = suite.parse_args(["--cases", *cases, "--out", str(work), "--skip-furnace", "--workers", "0"])
     return suite.run(args)
 
 
