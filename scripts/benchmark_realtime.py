@@ -8,11 +8,11 @@ Entry point of ``rt_lookdev.validation.benchmarks.realtime_benchmark``; ``--help
 import sys
 
 from rt_lookdev.validation.benchmarks import realtime_benchmark
+from rt_lookdev.validation.harness import entry
 
 
 def main(argv):
-    realtime_benchmark.run(realtime_benchmark.parse_args(argv))
-    return 0
+    return entry.main(realtime_benchmark, argv)
 
 
 if __name__ == "__main__":

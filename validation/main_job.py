@@ -226,9 +226,9 @@ def step_realtime_benchmark(out_dir, log=entry.flush_log):
         log(f"      skipped: {why}")
         return {"available": why, "passed": True, "summary_markdown": f"Not run: {why}."}
     args = realtime_benchmark.parse_args(["--quick", "--out", str(out_dir / "benchmarks" / "realtime.md")])
-    result = realtime_benchmark.run(args, log=lambda line: log("      " + line))
+    result = realtime_benchmark.run(args, progress=lambda line: log("      " + line))
     finite = all(r["finite"] for r in result["rows"] if not r.get("gpu"))
-    text = realtime_benchmark.format_markdown(result).split("\n", 2)[2]        # without the title
+    text = realtime_benchmark.to_markdown(result).split("\n", 2)[2]        # without the title
     return {"rows": result["rows"], "passed": finite, "summary_markdown": text + "\nFull table (1920 x 1080, 1/4/16 "
             "lights): docs/benchmarks/realtime.md (`python scripts/benchmark_realtime.py`)."}
 

@@ -25,6 +25,7 @@ CONVERTED = {
     "benchmarks/lut_benchmark": "benchmark_luts.py",
     "benchmarks/lut_export_benchmark": "benchmark_lut_export.py",
     "benchmarks/metal_split_benchmark": "benchmark_metal_split.py",
+    "benchmarks/realtime_benchmark": "benchmark_realtime.py",
     "benchmarks/rt_lit_benchmark": "benchmark_rt_lit.py",
     "benchmarks/specular_occlusion_benchmark": "benchmark_specular_occlusion.py",
     "benchmarks/wrapped_diffuse_benchmark": "benchmark_wrapped_diffuse.py",

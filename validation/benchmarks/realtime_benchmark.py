@@ -259,7 +259,9 @@ def _machine():
     return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(), "numpy": np.__version__}
 
 
-def run(args, log=entry.flush_log):
+def run(args, progress=entry.flush_log):
+    """Measure every feature set and light count; writes ``args.out`` (Markdown) and the JSON beside it (keeping the
+    GPU rows measured elsewhere)."""
     glsl_runner.disable_shader_cache()
     ok, why = glsl_runner.available()
     if not ok:
@@ -279,7 +281,7 @@ def run(args, log=entry.flush_log):
                               "lights": count, "kinds": list(light_kinds(count)), "precise": precise,
                               "device": device, "gpu": bool(args.device_label)})
                     rows.append(r)
-                    log(f"{fname:8s} {count:2d} lights precise={precise!s:5s}: frame {1e3 * r['frame_seconds_median']:8.1f} ms "
+                    progress(f"{fname:8s} {count:2d} lights precise={precise!s:5s}: frame {1e3 * r['frame_seconds_median']:8.1f} ms "
                         f"(min {1e3 * r['frame_seconds_min']:.1f}), compile {r['compile_seconds']:.2f} s, first frame "
                         f"{r['first_frame_seconds']:.2f} s, {r['shader_lines']} lines")
 
@@ -299,12 +301,13 @@ def run(args, log=entry.flush_log):
             previous = []
     result["rows"] = rows + previous
     json_path.write_text(json.dumps(result, indent=1))
-    out.write_text(format_markdown(result))
-    log(f"wrote {out} and {json_path}")
+    out.write_text(to_markdown(result))
+    progress(f"wrote {out} and {json_path}")
     return result
 
 
-def format_markdown(result):
+def to_markdown(result):
+    """The result as Markdown (realtime.md)."""
     m = result["machine"]
     w, h = result["resolution"]
     lines = ["# Real-time backend: frame time of the emitted RT Lit material", "",
