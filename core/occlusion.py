@@ -28,6 +28,7 @@ import numpy as np
 
 from . import shading_ops as op
 from .conventions import alpha_from_roughness
+from .energy import view_vector
 from .microfacet import reflect, sample_ggx_vndf, smith_g1, smith_g2_height_correlated
 from .sampling import hammersley_2d
 
@@ -84,10 +85,11 @@ def specular_occlusion_reference(mu, roughness, ao, samples=1 << 14):
     """The visible share of the GGX reflection of a view at ``mu`` = N.V when the visible directions are the cone
     about N of cosine-weighted share ``ao`` (scalars).  Heitz 2018 VNDF sampling: each microfacet normal m gives the
     light direction l = reflect(v, m) with weight G2(l, v) / G1(v) (the estimator of the BRDF times cos); SO is the
-    weighted share of the l inside the cone.  Float64; Hammersley points, so the same figures every run."""
+    weighted share of the l inside the cone (the estimator of ``energy.split_sum_terms``, written out here: that file
+    is a LUT bake source).  Float64; Hammersley points, so the same figures every run."""
     alpha = float(alpha_from_roughness(roughness))
-    mu = float(np.clip(mu, 1e-4, 1.0))
-    v = np.array([np.sqrt(1.0 - mu * mu), 0.0, mu])
+    v = view_vector(mu)
+    mu = float(v[2])
     u1, u2 = hammersley_2d(samples)
     m = sample_ggx_vndf(np.broadcast_to(v, (samples, 3)), alpha, u1, u2)
     l = reflect(np.broadcast_to(v, (samples, 3)), m)
