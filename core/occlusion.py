@@ -24,6 +24,8 @@ Where the estimates disagree with the reference, and by how much per (N.V, r, AO
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from . import shading_ops as op
@@ -33,23 +35,42 @@ from .microfacet import reflect, sample_ggx_vndf, smith_g1, smith_g2_height_corr
 from .sampling import hammersley_2d
 
 
-def visibility_cone_cos(ao):
-    """cos of the half-angle of the cone about N whose cosine-weighted share of the hemisphere is ``ao``: the
-    share of a cone of half-angle t is sin^2 t (Jimenez et al. 2016), so cos t = sqrt(1 - AO)."""
-    return op.sqrt(1.0 - op.saturate(ao))
+class Cone:
+    """A cone of directions about an axis, by its half-angle and 1 - cos(half-angle) (its solid angle over 2 pi).
+
+    Both are computed from the model's parameter without forming cos first: the lobe cone of a mirror-like surface
+    has 1 - cos ~ 2.3 alpha^2, which is 0 in float32 below alpha ~ 2e-4 (r ~ 0.015) when taken as 1 - 10^(-alpha^2),
+    and every ratio of solid angles then divides by 0."""
+
+    def __init__(self, one_minus_cos, half_angle):
+        self.one_minus_cos, self.half_angle = one_minus_cos, half_angle
 
 
-def specular_cone_cos(alpha):
-    """cos of the half-angle of the cone that stands for the GGX lobe of ``alpha``: 10^(-alpha^2)."""
-    return op.exp2(-3.321928 * alpha * alpha)
+def visibility_cone(ao):
+    """The cone about N whose cosine-weighted share of the hemisphere is ``ao``: the share of a cone of half-angle t is
+    sin^2 t (Jimenez et al. 2016), so sin t = sqrt(AO) and 1 - cos t = AO / (1 + sqrt(1 - AO))."""
+    ao = op.saturate(ao)
+    return Cone(op.safe_div(ao, 1.0 + op.sqrt(1.0 - ao)), op.asin(op.sqrt(ao)))
 
 
-def caps_intersection(cos_a, cos_b, cos_d):
-    """Solid angle of the intersection of two spherical caps (half-angle cosines ``cos_a``, ``cos_b``, axes
-    ``cos_d`` apart), over 2 pi: Oat & Sander 2007's approximation (a smoothstep between touching and nested caps).
-    Exact acos (``shading_ops.acos`` clamps its argument), not the fast fits engines use."""
-    a, b, d = op.acos(cos_a), op.acos(cos_b), op.acos(cos_d)
-    small_cap = 1.0 - op.maximum(cos_a, cos_b)                  # (1 - cos of the smaller half-angle)
+def specular_cone(alpha):
+    """The cone that stands for the GGX lobe of ``alpha``: cos = 10^(-alpha^2), Filament's aperture.  1 - cos =
+    1 - e^(-t), t = ln(10) alpha^2, by its series below t = 0.01 (error < t^4/24); half-angle 2 asin(sqrt((1 - cos)/2))."""
+    t = 2.302585 * alpha * alpha
+    one_minus_cos = op.select(op.less(t, 0.01), t * (1.0 - t * (0.5 - t * (1.0 / 6.0))), 1.0 - op.exp(-t))
+    return Cone(one_minus_cos, 2.0 * op.asin(op.sqrt(0.5 * one_minus_cos)))
+
+
+#: The upper hemisphere as a cone about N.
+HEMISPHERE = Cone(1.0, 0.5 * math.pi)     # Python floats: no float64 scalar into the float32 path
+
+
+def caps_intersection(cone_a, cone_b, cos_d):
+    """Solid angle of the intersection of two spherical caps (``Cone``s) whose axes are ``cos_d`` apart, over
+    2 pi: Oat & Sander 2007's approximation (a smoothstep between touching and nested caps).  Exact acos and asin
+    (``shading_ops`` clamps their arguments), not the fast fits engines use."""
+    a, b, d = cone_a.half_angle, cone_b.half_angle, op.acos(cos_d)
+    small_cap = op.minimum(cone_a.one_minus_cos, cone_b.one_minus_cos)
     delta = op.absolute(a - b)
     x = 1.0 - op.saturate(op.safe_div(d - delta, op.maximum(a + b - delta, 1e-4)))
     return small_cap * x * x * (3.0 - 2.0 * x)
@@ -58,9 +79,8 @@ def caps_intersection(cos_a, cos_b, cos_d):
 def specular_occlusion_cones(n_dot_r, ao, roughness):
     """GTSO without a bent normal (Jimenez et al. 2016): the visibility cone about N and the lobe cone about
     the reflection direction R (``n_dot_r`` = N.R), their intersection over the lobe cone; in [0, 1]."""
-    cos_s = specular_cone_cos(alpha_from_roughness(roughness))
-    cos_v = visibility_cone_cos(ao)
-    return op.saturate(op.safe_div(caps_intersection(cos_v, cos_s, n_dot_r), 1.0 - cos_s))
+    lobe = specular_cone(alpha_from_roughness(roughness))
+    return op.saturate(op.safe_div(caps_intersection(visibility_cone(ao), lobe, n_dot_r), lobe.one_minus_cos))
 
 
 def specular_occlusion_cones_clipped(n_dot_r, ao, roughness):
@@ -68,9 +88,9 @@ def specular_occlusion_cones_clipped(n_dot_r, ao, roughness):
     ``ao`` over the intersection at AO = 1 (the visibility cone the whole hemisphere), so that AO = 1 occludes
     nothing, where the plain ratio darkens rough and grazing lobes that reach below the horizon.  A variant of this
     project (measured in docs/benchmarks/specular_occlusion.md), not a published one."""
-    cos_s = specular_cone_cos(alpha_from_roughness(roughness))
-    above_horizon = caps_intersection(0.0 * cos_s, cos_s, n_dot_r)     # the hemisphere (0 * cos_s: its dtype)
-    return op.saturate(op.safe_div(caps_intersection(visibility_cone_cos(ao), cos_s, n_dot_r), above_horizon))
+    lobe = specular_cone(alpha_from_roughness(roughness))
+    above_horizon = caps_intersection(HEMISPHERE, lobe, n_dot_r)
+    return op.saturate(op.safe_div(caps_intersection(visibility_cone(ao), lobe, n_dot_r), above_horizon))
 
 
 def specular_occlusion_lagarde(n_dot_v, ao, roughness):
@@ -99,5 +119,15 @@ def specular_occlusion_reference(mu, roughness, ao, samples=1 << 14):
     total = weight.sum()
     if total <= 0.0:
         return 1.0
-    visible = mu_l >= float(visibility_cone_cos(ao))
+    visible = mu_l >= math.sqrt(1.0 - min(max(float(ao), 0.0), 1.0))      # the cone of visibility_cone(ao)
     return float(weight[visible].sum() / total)
+
+
+#: Occlusion model (``rt_lit_interface.OCCLUSION_MODELS``, "none" excepted) -> its specular occlusion, a function
+#: of (N.V, AO, Blender roughness).  Without a bent normal the lobe's axis is the mirror direction R, and
+#: N.R = N.V.
+SPECULAR_OCCLUSION = {
+    "lagarde": specular_occlusion_lagarde,
+    "cones": specular_occlusion_cones,
+    "cones_clipped": specular_occlusion_cones_clipped,
+}

@@ -34,6 +34,21 @@ def test_estimates_are_bounded_finite_and_float32_at_the_edges():
         assert np.isfinite(so).all() and (so >= 0.0).all() and (so <= 1.0).all(), name
 
 
+def test_float32_equals_float64_down_to_mirror_like_lobes():
+    """The cones' solid angles are computed without 1 - cos: as 1 - 10^(-alpha^2) the lobe of r < 0.015 had no solid
+    angle in float32 and a mirror-like surface with its reflection in plain view came out fully occluded (SO = 0)."""
+    r = np.array([0.0, 1e-3, 0.003, 0.01, 0.015, 0.03, 0.1, 0.5, 1.0])
+    mu, ao = np.meshgrid(np.linspace(0.0, 1.0, 11), np.linspace(0.0, 1.0, 11), indexing="ij")
+    for name, fn in ESTIMATES.items():
+        for rr in r:
+            so64 = np.asarray(fn(mu, ao, np.full_like(mu, rr)))
+            so32 = np.asarray(fn(mu.astype(np.float32), ao.astype(np.float32), np.full(mu.shape, rr, np.float32)))
+            assert so32.dtype == np.float32
+            np.testing.assert_allclose(so32, so64, atol=2e-4, err_msg=f"{name} r={rr}")
+    # a mirror at normal view under a half-open sky sees its reflection: nothing occluded
+    assert float(ESTIMATES["cones_clipped"](np.float32(1.0), np.float32(0.5), np.float32(0.0))) == 1.0
+
+
 def test_no_occlusion_at_ao_1_for_lagarde_and_the_clipped_cones_and_the_plain_cones_darken_grazing_rough_lobes():
     mu = np.linspace(0.02, 1.0, 20)
     for name in ("lagarde", "cones_clipped"):
