@@ -38,9 +38,9 @@ from ..ir.numpy_backend import evaluate, flat_node_count
 from ..ir.tables import table_names
 from ..lut.lookup import REFERENCES
 from . import light_shading, world_shading
-from .rt_lit_interface import (EMISSION_OUTPUT, GEOMETRY_INPUTS, LIGHT_KINDS, RADIANCE_OUTPUT, RT_LIT_INPUTS,
-                               RT_LIT_OUTPUTS, SURFACE_OUTPUTS, WORLD_OUTPUT, Features, light_input, light_output,
-                               world_input)
+from .rt_lit_interface import (EMISSION_OUTPUT, GEOMETRY_INPUTS, LIGHT_KINDS, OCCLUSION_INPUT, OCCLUSION_SOCKET,
+                               RADIANCE_OUTPUT, RT_LIT_INPUTS, RT_LIT_OUTPUTS, SURFACE_OUTPUTS, WORLD_OUTPUT, Features,
+                               light_input, light_output, world_input)
 from .surface import SURFACE
 
 
@@ -55,15 +55,16 @@ def compose(tables, features, material, geometry, lights_in_scene, world=None):
 
     ``material``: RT_LIT_INPUTS name -> value; ``geometry``: GEOMETRY_INPUTS name -> value;
     ``lights_in_scene``: [(kind, {parameter -> value})]; ``world``: None or (``WorldEnvironment``,
-    {``WORLD_PARAMETERS`` name -> value}).  Values are arrays (``tables`` holding data, the environment's
-    table included) or Exprs (``tables`` = ``REFERENCES``)."""
+    {``WORLD_PARAMETERS`` name -> value}); with ``features.occlusion`` on, ``geometry`` also holds the
+    renderer's ambient occlusion (``OCCLUSION_INPUT``).  Values are arrays (``tables`` holding data, the
+    environment's table included) or Exprs (``tables`` = ``REFERENCES``)."""
     surface = SURFACE(**{k: material[k] for k in RT_LIT_INPUTS},
                       **{k: geometry[k] for k in ("Geometry Normal", "Incoming")})
     parts = [surface["Emission"]]
     parts += _shade_lights(tables, features, surface, geometry["Position"], list(lights_in_scene))
     if world is not None:
         env, params = world
-        parts.append(world_shading.shade_world(tables, features, env, surface, params))
+        parts.append(world_shading.shade_world(tables, features, env, surface, params, geometry.get(OCCLUSION_INPUT)))
     return parts
 
 
@@ -144,8 +145,9 @@ class RtLitMaterial:
 
     ``function``: the ``expr.Function``; its inputs are ``material_inputs`` (RT_LIT_INPUTS),
     ``geometry_inputs`` (GEOMETRY_INPUTS), ``light_inputs`` (per light: parameter -> input name) and
-    ``world_inputs`` (world parameter -> input name); its outputs ``RADIANCE_OUTPUT`` and the parts
-    ``part_outputs`` (emission, each light, the world) that sum to it."""
+    ``world_inputs`` (world parameter -> input name) and ``occlusion_inputs`` (``OCCLUSION_INPUT`` when the
+    World term is occluded, else none); its outputs ``RADIANCE_OUTPUT`` and the parts ``part_outputs``
+    (emission, each light, the world) that sum to it."""
     features: Features
     light_kinds: tuple
     environment: object
@@ -155,6 +157,7 @@ class RtLitMaterial:
     light_inputs: tuple
     world_inputs: dict
     part_outputs: tuple
+    occlusion_inputs: tuple = ()
 
     @property
     def name(self):
@@ -162,11 +165,11 @@ class RtLitMaterial:
 
     @property
     def internal_inputs(self):
-        """Inputs that a node tree feeds from inside (geometry, lights, world), not from its interface."""
+        """Inputs that a node tree feeds from inside (geometry, lights, world, occlusion), not from its interface."""
         names = list(self.geometry_inputs)
         for per_light in self.light_inputs:
             names += list(per_light.values())
-        return names + list(self.world_inputs.values())
+        return names + list(self.world_inputs.values()) + list(self.occlusion_inputs)
 
     def table_names(self):
         return table_names(self.function.outputs)
@@ -189,8 +192,8 @@ class RtLitMaterial:
         return dict(zip(outputs, result))
 
 
-def _function_inputs(light_kinds, environment):
-    """(input name -> kind, sockets, light inputs, world inputs) of the material function."""
+def _function_inputs(features, light_kinds, environment):
+    """(input name -> kind, sockets, light inputs, world inputs, occlusion inputs) of the material function."""
     kinds, sockets = {}, {}
     for name, sock in {**RT_LIT_INPUTS, **GEOMETRY_INPUTS}.items():
         kinds[name] = FLOAT if sock.kind == "float" else VECTOR
@@ -213,7 +216,11 @@ def _function_inputs(light_kinds, environment):
             world[param] = world_input(param)
             kinds[world[param]] = FLOAT if sock.kind == "float" else VECTOR
             sockets[world[param]] = sock
-    return kinds, sockets, tuple(per_light), world
+    occlusion = ()
+    if environment is not None and features.occlusion != "none":     # only the World term is occluded
+        occlusion = (OCCLUSION_INPUT,)
+        kinds[OCCLUSION_INPUT], sockets[OCCLUSION_INPUT] = FLOAT, OCCLUSION_SOCKET
+    return kinds, sockets, tuple(per_light), world, occlusion
 
 
 def build_rt_lit(features=Features(), light_kinds=(), environment=None):
@@ -233,14 +240,14 @@ def op_counts(features, light_kinds=(), environment=None):
 
 @functools.lru_cache(maxsize=32)
 def _build(features, light_kinds, environment, folded, table_filter):
-    kinds, sockets, per_light, world = _function_inputs(light_kinds, environment)
+    kinds, sockets, per_light, world, occlusion = _function_inputs(features, light_kinds, environment)
     part_names = [EMISSION_OUTPUT] + [light_output(i) for i in range(len(light_kinds))]
     if environment is not None:
         part_names.append(WORLD_OUTPUT)
 
     def body(**kw):
         material = {k: kw[k] for k in RT_LIT_INPUTS}
-        geometry = {k: kw[k] for k in GEOMETRY_INPUTS}
+        geometry = {k: kw[k] for k in (*GEOMETRY_INPUTS, *occlusion)}
         in_scene = [(kind, {p: kw[n] for p, n in names.items()}) for kind, names in zip(light_kinds, per_light)]
         world_in = (environment, {p: kw[n] for p, n in world.items()}) if environment is not None else None
         parts = compose(REFERENCES, features, material, geometry, in_scene, world_in)
@@ -255,4 +262,4 @@ def _build(features, light_kinds, environment, folded, table_filter):
     name = f"RT Lit ({features.label()}; {len(light_kinds)} lights{env_label})"
     function = define(name, body, kinds, f"RT Lit lookdev material ({features.label()})", (sockets, out_sockets))
     return RtLitMaterial(features, light_kinds, environment, function, tuple(RT_LIT_INPUTS), tuple(GEOMETRY_INPUTS),
-                         per_light, world, tuple(part_names))
+                         per_light, world, tuple(part_names), occlusion)

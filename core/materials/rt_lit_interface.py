@@ -34,6 +34,14 @@ PRINCIPLED_SHEEN = "zeltner"
 #: Fdez-Aguera's multiple scattering under the environment: lit by the irradiance (the paper) or by
 #: the prefiltered radiance (the talk's approximation); core/materials/world.py.
 ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")
+#: Occlusion of the World term by the scene (issue 29; core/occlusion.py): none (the world lights every point
+#: as if nothing stood around it), or the renderer's ambient occlusion on the world's diffuse, sheen and cloth
+#: and a specular occlusion derived from it on the world's specular: Lagarde & de Rousiers 2014 ("lagarde"),
+#: Jimenez et al. 2016's cones ("cones") or the cones clipped by the horizon ("cones_clipped", the most
+#: accurate of the three in docs/benchmarks/specular_occlusion.md).  The lights are not occluded by it.
+OCCLUSION_MODELS = ("none", "lagarde", "cones", "cones_clipped")
+#: The model an artist gets when switching world occlusion on (the Convert dialog, New Lookdev Scene).
+DEFAULT_OCCLUSION = "cones_clipped"
 
 #: Input name -> socket, in interface order.  Names follow the Principled BSDF where one exists,
 #: so a conversion maps them one to one.
@@ -63,6 +71,11 @@ RT_LIT_INPUTS = {
     "Normal": vector("Shading normal (world space); unlinked = the geometry's normal", "NONE",
                      hide_value=True),
 }
+
+#: The renderer's ambient occlusion at the shading point (an input of materials with world occlusion on: Blender's
+#: Ambient Occlusion node feeds it in Cycles and EEVEE, an engine its own AO in the shader backend).
+OCCLUSION_INPUT = "Ambient Occlusion"
+OCCLUSION_SOCKET = factor(1.0, "Cosine-weighted visible share of the hemisphere about the normal (1: unoccluded)")
 
 #: The shading point, as the node backend's Geometry node delivers it.
 GEOMETRY_INPUTS = {
@@ -143,6 +156,7 @@ class Features:
     sheen: str = "none"              # one of SHEEN_MODELS (True / False: "disney_talk" / "none")
     cloth: bool = False
     environment_ms: str = "irradiance"   # one of ENVIRONMENT_MS_FORMS (Fdez-Aguera under the world)
+    occlusion: str = "none"              # one of OCCLUSION_MODELS (the World term's occlusion)
 
     def __post_init__(self):
         if isinstance(self.sheen, (bool, int)):       # the old switch (stored materials, Features(sheen=True))
@@ -155,6 +169,8 @@ class Features:
             raise ValueError(f"diffuse model must be one of {DIFFUSE_MODELS}, got {self.diffuse!r}")
         if self.environment_ms not in ENVIRONMENT_MS_FORMS:
             raise ValueError(f"environment_ms must be one of {ENVIRONMENT_MS_FORMS}, got {self.environment_ms!r}")
+        if self.occlusion not in OCCLUSION_MODELS:
+            raise ValueError(f"occlusion must be one of {OCCLUSION_MODELS}, got {self.occlusion!r}")
 
     def as_dict(self):
         return asdict(self)
@@ -169,6 +185,8 @@ class Features:
         if self.specular == "fdez_aguera" and self.environment_ms != "irradiance":
             parts[0] += f" ({self.environment_ms})"
         parts += [p for p, on in ((_SHEEN_LABELS[self.sheen], self.sheen != "none"), ("cloth", self.cloth)) if on]
+        if self.occlusion != "none":
+            parts.append(f"{self.occlusion.replace('_', '-')} AO")
         return ", ".join(parts)
 
 

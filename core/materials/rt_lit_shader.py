@@ -17,6 +17,9 @@ conventions are Blender's, so an engine passes the values Blender shows:
 - world: ``u_world_sh[9]`` (L2 SH radiance, Ramamoorthi & Hanrahan 2001 order, image frame, strength 1),
   ``u_world_strength``, ``u_world_rotation`` (the Mapping node's Euler XYZ, radians) and the
   prefiltered levels' texture;
+- occlusion (materials with ``Features.occlusion`` on and a world): ``u_ambient_occlusion``, the engine's ambient
+  occlusion at the fragment (1: unoccluded); an engine with an AO buffer binds its read there (a uniform here, so
+  the interface stays one set of values per draw);
 - camera: ``u_camera_position``, ``u_camera_forward`` (unit view direction) and
   ``u_camera_orthographic`` (1: the view direction is -forward everywhere, as Blender's orthographic
   camera);
@@ -38,7 +41,7 @@ from .. import lights
 from ..ir import shader_text
 from ..ir.expr import FLOAT
 from . import rt_lit
-from .rt_lit_interface import Features, LIGHT_KINDS, RT_LIT_INPUTS
+from .rt_lit_interface import LIGHT_KINDS, OCCLUSION_SOCKET, RT_LIT_INPUTS, Features
 
 #: Light parameters that are one vector uniform field: prefix -> (field, type, components in field order).
 _VECTOR_FIELDS = {
@@ -110,12 +113,12 @@ class MaterialShader:
     light_slots: tuple
     module: object
 
-    def uniform_values(self, material_values, lights_values=(), world_values=None):
+    def uniform_values(self, material_values, lights_values=(), world_values=None, ambient_occlusion=1.0):
         """{uniform path -> value} for the material's inputs (RT_LIT_INPUTS name -> value), its lights'
-        parameters (one dict of driver values per light, in the material's light order) and the world's
-        (``WORLD_PARAMETERS`` name -> value): e.g. "u_quad_lights[0].location" -> (x, y, z), "u_world_sh" -> nine
-        RGB triples.  Camera
-        uniforms and tables are the renderer's."""
+        parameters (one dict of driver values per light, in the material's light order), the world's
+        (``WORLD_PARAMETERS`` name -> value) and the ambient occlusion (materials with occlusion on): e.g.
+        "u_quad_lights[0].location" -> (x, y, z), "u_world_sh" -> nine RGB triples.  Camera uniforms and tables are
+        the renderer's."""
         out = {}
         for name, sock in RT_LIT_INPUTS.items():
             if name in _VARYING_INPUTS:
@@ -138,8 +141,12 @@ class MaterialShader:
                                  for i in range(_WORLD_SH)]
             out["u_world_strength"] = float(world_values["Strength"])
             out["u_world_rotation"] = tuple(float(v) for v in np.asarray(world_values["Rotation"])[:3])
+        if self.material.occlusion_inputs:
+            out[_OCCLUSION_UNIFORM] = float(ambient_occlusion)
         return out
 
+
+_OCCLUSION_UNIFORM = "u_ambient_occlusion"
 
 #: RT Lit inputs fed per fragment, not by a uniform: the shading normal is the interpolated normal.
 _VARYING_INPUTS = ("Normal",)
@@ -221,6 +228,12 @@ class _Interface:
             else:
                 self.bindings[name] = {"Strength": "u_world_strength", "Rotation": "u_world_rotation"}[param]
 
+    def occlusion(self):
+        for name in self.material.occlusion_inputs:
+            self.lines.append("// Occlusion of the World term: the engine's ambient occlusion (core/occlusion.py)")
+            self.declare(_OCCLUSION_UNIFORM, "float", f"{name}: {OCCLUSION_SOCKET.description}")
+            self.bindings[name] = _OCCLUSION_UNIFORM
+
     def camera_and_geometry(self):
         self.lines.append("// Camera")
         self.declare("u_camera_position", "vec3", "world-space camera position, m")
@@ -235,6 +248,7 @@ def _declarations(material, dialect):
     iface.material_inputs()
     iface.lights()
     iface.world()
+    iface.occlusion()
     iface.camera_and_geometry()
     missing = [n for n, _ in material.function.inputs if n not in iface.bindings]
     if missing:

@@ -36,6 +36,13 @@ Mixing the two F0 *after* these formulas is what three.js (#32190) and Bevy (#23
 they are non-linear in F0, so a mixed F0 = lerp(F0_dielectric, base colour, metallic) over-brightens
 partly metallic surfaces.  The lights shade the two apart too (light_shading.SPLIT_F0_MODELS).
 
+Occlusion (``Features.occlusion``, issue 29)
+-------------------------------------------
+With occlusion on, the renderer's ambient occlusion AO (Blender's Ambient Occlusion node; an engine's own AO)
+scales the broad lobes (diffuse, rough diffuse, sheen, cloth) and a specular occlusion SO(N.V, AO, r) derived
+from it scales the GGX specular (core/occlusion.py: Lagarde & de Rousiers 2014, section 4.10.2, or Jimenez et
+al. 2016's cones).  Both are visibility estimates, not radiance ones: the occluder's own light is not added.
+
 Specular dominant direction (Lagarde & de Rousiers 2014, "Moving Frostbite to PBR", listing 22):
 lerp(N, R, s (sqrt(s) + alpha)) with s = 1 - alpha, alpha = r^2, R the mirror direction.
 """
@@ -50,7 +57,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import indirect, multiscatter, rough_diffuse, shading_ops as op, sheen
+from .. import indirect, multiscatter, occlusion, rough_diffuse, shading_ops as op, sheen
 from ..conventions import alpha_from_roughness
 from ..fresnel import fresnel_average
 from ..ir.functions import NodeFunction
@@ -60,7 +67,7 @@ from ..ltc import polygon, shading as ltc_shading
 from ..lut import exr_io
 from ..lut.lookup import REFERENCES
 from .light_shading import layer_sheen
-from .rt_lit_interface import SURFACE_OUTPUTS, world_input
+from .rt_lit_interface import OCCLUSION_INPUT, OCCLUSION_SOCKET, SURFACE_OUTPUTS, world_input
 
 PI = math.pi
 
@@ -439,16 +446,18 @@ def world_surface(features):
             + (("Sheen Roughness",) if features.sheen == "zeltner" else ()))
 
 
-def world_radiance(tables, features, env, surface, params):
+def world_radiance(tables, features, env, surface, params, ambient_occlusion=None):
     """Radiance towards the viewer from the environment (3-vector).
 
     ``surface``: RTL Surface outputs (at least ``WORLD_SURFACE``); ``params``: ``WORLD_PARAMETERS``
-    names -> values; ``env``: the ``WorldEnvironment``; ``tables``: the LUT set (``lookup.LutSet``)."""
+    names -> values; ``env``: the ``WorldEnvironment``; ``tables``: the LUT set (``lookup.LutSet``);
+    ``ambient_occlusion``: the renderer's AO at the point (with ``features.occlusion`` on; ``occluded``)."""
     rotated = WORLD_ROTATION(N=surface["N"], V=surface["V"], Rotation=params["Rotation"])
     n, v = rotated["N"], rotated["V"]
     coeffs = [params[name] for name in SH_NAMES]
     r = surface["Roughness"]
     irradiance = sh_lobe(coeffs, n, indirect.COSINE_LOBE_ZONAL)
+    broad, glossy = _occlusion_factors(features, surface, r, ambient_occlusion)
 
     # diffuse
     if features.diffuse == "lambert":
@@ -467,16 +476,17 @@ def world_radiance(tables, features, env, surface, params):
         lobe = SH_LTC_COD(tables, N=n, V=v, Roughness=r)
         diffuse = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
 
-    spec = _world_specular(tables, features, env, surface, n, v, r, irradiance)
+    spec = occluded(_world_specular(tables, features, env, surface, n, v, r, irradiance), glossy)
     if features.cloth:
         lobe = SH_LTC_CLOTH(tables, N=n, V=v, Roughness=r)
         cloth = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
         w = surface["Cloth Weight"]
-        cloth = op.scale(op.vmul(surface["Cloth Color"], cloth), w)
+        cloth = occluded(op.scale(op.vmul(surface["Cloth Color"], cloth), w), broad)
         spec = cloth if spec is None else op.scale(spec, 1.0 - w) + cloth
     total = op.vmul(surface["Albedo"], diffuse)
     if features.diffuse == "oren_nayar":
         total = total + _rough_diffuse_multiscatter_world(coeffs, n, surface, rough["MS Weight"])
+    total = occluded(total, broad)
     if spec is not None:
         total = spec + total
     if features.sheen != "none":
@@ -486,9 +496,31 @@ def world_radiance(tables, features, env, surface, params):
         else:
             lobe = (SH_LTC_SHEEN if features.sheen == "disney_talk" else SH_LTC_DISNEY_FITTED)(tables, N=n, V=v)
             sheen_lobe = op.scale(sh_lobe(coeffs, lobe["Axis"], indirect.COSINE_LOBE_ZONAL), lobe["Magnitude"])
-        total = layer_sheen(features, surface, total, op.vmul(surface["Sheen Color"], sheen_lobe),
+        total = layer_sheen(features, surface, total, occluded(op.vmul(surface["Sheen Color"], sheen_lobe), broad),
                             lobe["Albedo"] if features.sheen == "zeltner" else None)
     return op.scale(total, params["Strength"])
+
+
+def _occlusion_factors(features, surface, roughness, ambient_occlusion):
+    """(occlusion of the broad lobes, of the GGX specular) for ``features.occlusion``; (None, None) when off.
+
+    The broad lobes (diffuse, rough diffuse, sheen, cloth) take the ambient occlusion itself: AO is the
+    cosine-weighted visible share, exact for Lambert under a uniform world and what engines apply to all of
+    them.  The GGX specular takes the specular occlusion of the model (core/occlusion.py)."""
+    if features.occlusion == "none":
+        return None, None
+    if ambient_occlusion is None:
+        raise ValueError(f"occlusion {features.occlusion!r} needs the ambient occlusion ({OCCLUSION_INPUT!r})")
+    ao = op.saturate(ambient_occlusion)
+    n_dot_v = op.saturate(op.dot(surface["N"], surface["V"]))
+    return ao, occlusion.SPECULAR_OCCLUSION[features.occlusion](n_dot_v, ao, roughness)
+
+
+def occluded(radiance, factor):
+    """``radiance`` times the occlusion ``factor`` (None: unoccluded; None radiance stays None)."""
+    if radiance is None or factor is None:
+        return radiance
+    return op.scale(radiance, factor)
 
 
 def _world_specular(tables, features, env, surface, n, v, r, irradiance):
@@ -512,19 +544,26 @@ def shade_world_function(features, env):
     def shade(tables, **kw):
         surface = {k: kw[k] for k in world_surface(features)}
         params = {k: kw[world_input(k)] for k in WORLD_PARAMETERS}
-        return {"Radiance": world_radiance(tables, features, env, surface, params)}
+        return {"Radiance": world_radiance(tables, features, env, surface, params, kw.get(OCCLUSION_INPUT))}
 
     inputs = {k: SURFACE_OUTPUTS[k] for k in world_surface(features)}
     inputs.update({world_input(k): s for k, s in WORLD_PARAMETERS.items()})
+    if features.occlusion != "none":
+        inputs[OCCLUSION_INPUT] = OCCLUSION_SOCKET
     return NodeFunction(f"RTL Shade World ({features.label()}; {env.name})", shade, inputs,
                         {"Radiance": color((0.0, 0.0, 0.0), "Radiance towards the viewer from the world")},
                         f"The world's image-based lighting on the RT Lit material ({features.label()})",
                         tables=REFERENCES)
 
 
-def shade_world(tables, features, env, surface, params):
-    """The world term: ``surface`` the "RTL Surface" outputs, ``params`` the ``WORLD_PARAMETERS``;
-    arrays (``tables`` with data, the environment's table included) or Exprs."""
+def shade_world(tables, features, env, surface, params, ambient_occlusion=None):
+    """The world term: ``surface`` the "RTL Surface" outputs, ``params`` the ``WORLD_PARAMETERS``,
+    ``ambient_occlusion`` the renderer's AO (with ``features.occlusion`` on); arrays (``tables`` with data, the
+    environment's table included) or Exprs."""
     args = {k: surface[k] for k in world_surface(features)}
     args.update({world_input(k): params[k] for k in WORLD_PARAMETERS})
+    if features.occlusion != "none":
+        if ambient_occlusion is None:
+            raise ValueError(f"occlusion {features.occlusion!r} needs the ambient occlusion ({OCCLUSION_INPUT!r})")
+        args[OCCLUSION_INPUT] = ambient_occlusion
     return shade_world_function(features, env)(tables, **args)["Radiance"]

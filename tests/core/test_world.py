@@ -8,20 +8,23 @@
 - the dielectric and metallic parts are shaded separately, then mixed (not one mixed F0);
 - the diffuse models equal core/indirect.py's functions;
 - traced graphs evaluate like the direct numpy code (float64 2e-6 as test_ltc_trace, float32 1e-4), with no NaN/Inf,
-  and every node function stays under the group-size cap.
+  and every node function stays under the group-size cap;
+- world occlusion: the ambient occlusion scales the broad lobes, the specular occlusion of the chosen model the
+  specular; AO = 1 changes nothing; the AO input exists only on occluded materials with a world.
 """
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from rt_lookdev.core import indirect
+from rt_lookdev.core import indirect, occlusion
 from rt_lookdev.core.environment import prefilter, sh
 from rt_lookdev.core.ir.numpy_backend import node_count
 from rt_lookdev.core.lut import lookup
 from rt_lookdev.core.materials import rt_lit
 from rt_lookdev.core.materials import world_shading as world
-from rt_lookdev.core.materials.rt_lit_interface import RT_LIT_INPUTS, Features
+from rt_lookdev.core.materials.rt_lit_interface import OCCLUSION_INPUT, RT_LIT_INPUTS, Features
 
 LEVELS = tuple(k / 8.0 for k in range(9))
 MAX_NODES = 144
@@ -247,6 +250,8 @@ def test_world_functions_are_small():
     fns += [world.specular_function(s, form) for s in ("single", "turquin", "fdez_aguera", "kulla_conty")
             for form in ("irradiance", "radiance")]
     fns += [world.shade_world_function(f, env) for f in ALL_FEATURES]
+    fns += [world.shade_world_function(replace(f, occlusion=model), env) for f in ALL_FEATURES[-3:]
+            for model in ("lagarde", "cones", "cones_clipped")]
     for fn in fns:
         count = node_count(tuple(fn.function.outputs.values()))
         assert count <= MAX_NODES, (fn.name, count)
@@ -259,3 +264,95 @@ def test_environment_validation():
         world.WorldEnvironment("bad", np.zeros((9, 4, 4), np.float32), (0.0, 0.3, 1.0))
     with pytest.raises(ValueError):
         Features(environment_ms="both")
+
+
+# --- world occlusion (Features.occlusion; issue 29) -----------------------------------------------------------------
+
+OCCLUDED = ("lagarde", "cones", "cones_clipped")
+
+
+def _occluded_radiance(features, env, params, m, normals, views, ao):
+    geo = {"Position": np.zeros(3), "Geometry Normal": normals, "Incoming": views, OCCLUSION_INPUT: ao}
+    return rt_lit.rt_lit_radiance(TABLES["luts"], features, m, geo, [], world=(env, params))
+
+
+@pytest.mark.parametrize("model", OCCLUDED)
+def test_occlusion_scales_the_diffuse_by_ao_and_the_specular_by_its_specular_occlusion(model):
+    """world(AO) = AO x (the world without specular) + SO(N.V, AO, r) x (the specular part), SO from core/occlusion.py:
+    the diffuse and the specular each take their own factor, nothing else changes."""
+    rng = np.random.default_rng(11)
+    env = _random_env(rng)
+    coeffs = rng.normal(size=(9, 3))
+    coeffs[0] += 4.0
+    normals, views = _geometry(rng, 300)
+    n = len(normals)
+    m = _material(rng, n)
+    params = _params(coeffs, 1.3, (0.3, 0.1, -0.7))
+    ao = rng.uniform(0.0, 1.0, n)
+    base = Features("turquin", "cod")
+    everything = _radiance(base, env, params, m, normals, views)
+    diffuse = _radiance(replace(base, specular="none"), env, params, m, normals, views)
+    n_dot_v = np.clip(np.sum(normals * views, -1), 0.0, 1.0)
+    so = occlusion.SPECULAR_OCCLUSION[model](n_dot_v, ao, m["Roughness"])
+    want = ao[:, None] * diffuse + so[:, None] * (everything - diffuse)
+    got = _occluded_radiance(replace(base, occlusion=model), env, params, m, normals, views, ao)
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
+    assert np.all(got <= everything + 1e-9)
+
+
+@pytest.mark.parametrize("model", ("lagarde", "cones_clipped"))
+def test_occlusion_at_ao_one_changes_nothing(model):
+    """AO = 1 (nothing around the point): the occluded world equals the unoccluded one for the models that keep the
+    whole lobe then (plain cones darken lobes reaching under the horizon: docs/benchmarks/specular_occlusion.md)."""
+    rng = np.random.default_rng(12)
+    env = _random_env(rng)
+    coeffs = rng.normal(size=(9, 3))
+    coeffs[0] += 4.0
+    normals, views = _geometry(rng, 200)
+    m = _material(rng, len(normals))
+    params = _params(coeffs)
+    features = Features("fdez_aguera", "cod", "zeltner", True)
+    want = _radiance(features, env, params, m, normals, views)
+    got = _occluded_radiance(replace(features, occlusion=model), env, params, m, normals, views, np.ones(len(normals)))
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("features", [Features("turquin", "cod", occlusion="cones_clipped"),
+                                      Features("kulla_conty", "oren_nayar", "zeltner", True, occlusion="lagarde")],
+                         ids=lambda f: f.label())
+def test_traced_occluded_world_equals_numpy(features):
+    """The material function has the AO input exactly when the world is shaded and occluded, and evaluates like
+    the direct numpy code (as test_traced_world_equals_numpy), float32 included."""
+    rng = np.random.default_rng(13)
+    env = _random_env(rng)
+    coeffs = rng.normal(size=(9, 3))
+    coeffs[0] += 4.0
+    normals, views = _geometry(rng, 300)
+    n = len(normals)
+    m = _material(rng, n)
+    params = _params(coeffs, 0.8, (0.2, -0.4, 1.3))
+    ao = rng.uniform(0.0, 1.0, n)
+    ao[:2] = (0.0, 1.0)
+    want = _occluded_radiance(features, env, params, m, normals, views, ao)
+    material = rt_lit.build_rt_lit(features, (), env)
+    assert material.occlusion_inputs == (OCCLUSION_INPUT,) and OCCLUSION_INPUT in material.internal_inputs
+    assert rt_lit.build_rt_lit(features, ("point",), None).occlusion_inputs == ()     # no world: nothing occluded
+    inputs = dict(m, Position=np.zeros((n, 3)), **{"Geometry Normal": normals, "Incoming": views})
+    inputs.update({material.world_inputs[k]: (np.broadcast_to(v, (n, 3)) if np.ndim(v) else np.full(n, v))
+                   for k, v in params.items()})
+    inputs["Normal"] = np.zeros((n, 3))
+    with pytest.raises(KeyError):
+        material.evaluate(inputs, TABLES["luts"], np.float64)
+    inputs[OCCLUSION_INPUT] = ao
+    np.testing.assert_allclose(material.evaluate(inputs, TABLES["luts"], np.float64)["Radiance"], want,
+                               rtol=2e-6, atol=1e-9)
+    got32 = material.evaluate(inputs, TABLES["luts"], np.float32)["Radiance"]
+    assert np.all(np.isfinite(got32))
+    np.testing.assert_allclose(got32, want, rtol=1e-4, atol=1e-5)
+
+
+def test_occlusion_switch_validates_and_names_the_group():
+    with pytest.raises(ValueError, match="occlusion"):
+        Features(occlusion="ssao")
+    assert Features(occlusion="cones_clipped").label() == "turquin, cod, cones-clipped AO"
+    assert Features.from_dict({"specular": "single"}).occlusion == "none"      # materials stored before the switch

@@ -140,15 +140,17 @@ def test_world_functions_compute_like_numpy(gl, tables, environment):
         _assert_conforms(fn.name, compare_function(fn, {k: vals[k] for k in fn.input_sockets}, tables, runner=gl))
 
 
-@pytest.mark.parametrize("features", ["all", "demo"])
+@pytest.mark.parametrize("features", ["all", "demo", "occluded"])
 def test_whole_material_computes_like_numpy(gl, tables, environment, features):
-    """The RT Lit material for every light kind and the world, as one emitted function."""
+    """The RT Lit material for every light kind and the world, as one emitted function (with the world occluded:
+    the AO input, the clipped cones)."""
     from rt_lookdev.core.materials import rt_lit
-    from rt_lookdev.core.materials.rt_lit_interface import Features
+    from rt_lookdev.core.materials.rt_lit_interface import OCCLUSION_INPUT, Features
 
-    chosen = (Features("kulla_conty", "wrapped", sheen=True, cloth=True) if features == "all"
-              else Features("turquin", "cod"))
+    chosen = {"all": Features("kulla_conty", "wrapped", sheen=True, cloth=True), "demo": Features("turquin", "cod"),
+              "occluded": Features("turquin", "cod", cloth=True, occlusion="cones_clipped")}[features]
     material = rt_lit.build_rt_lit(chosen, ("quad", "disk", "point", "spot", "sun"), environment)
     vals = grids.material_inputs(material, size=SIZE)
+    assert (OCCLUSION_INPUT in vals) == (features == "occluded")
     report = compare_function(material.function, vals, material.tables(tables), runner=gl)
     _assert_conforms(material.name, report)

@@ -68,6 +68,9 @@ MATERIALS = {
 #: The rough diffuse (Oren-Nayar as Cycles): every light kind and the world.
 MATERIALS["turquin + Oren-Nayar, every light kind, world"] = (dict(specular="turquin", diffuse="oren_nayar"),
                                                              ("quad", "disk", "point", "spot", "sun"), True)
+#: World occlusion: the engine's AO as a uniform (issue 29).
+MATERIALS["turquin + CoD, clipped-cones occlusion, quad, world"] = (
+    dict(specular="turquin", diffuse="cod", occlusion="cones_clipped"), ("quad",), True)
 
 
 @pytest.fixture(scope="module")
@@ -98,6 +101,8 @@ def test_material_shader_compiles(glslang_path, environment, dialect, case):
     for kind in set(kinds):
         assert f"u_{kind}_lights[{kinds.count(kind)}]" in shader.fragment
     assert ("u_world_sh[9]" in shader.fragment) == world
+    assert ("uniform float u_ambient_occlusion;" in shader.fragment or "float u_ambient_occlusion;" in shader.fragment) \
+        == ("occlusion" in features)
     # papers named in the comments of the functions they implement
     if features.get("specular") == "kulla_conty":
         assert "Kulla" in shader.fragment

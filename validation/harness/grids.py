@@ -17,6 +17,7 @@ from ...core import lights
 from ...core.environment import equirect
 from ...core.ir import Graph
 from ...core.ir.expr import OPS, topological_order
+from ...core.materials.rt_lit_interface import OCCLUSION_INPUT
 
 #: Side of the square per-texel grids (one render pixel per texel).
 SIZE = 48
@@ -304,7 +305,15 @@ def world_inputs(seed=5, size=SIZE):
         vals[f"SH {i}"] = np.broadcast_to(coeffs[i], shape + (3,)).copy()
         vals[f"World SH {i}"] = vals[f"SH {i}"]
     vals["Diffuse Roughness"] = _diffuse_roughness(rng, shape)
+    vals[OCCLUSION_INPUT] = ambient_occlusion(np.random.default_rng(seed + 1), shape)
     return {k: np.asarray(a, np.float32) for k, a in vals.items()}
+
+
+def ambient_occlusion(rng, shape):
+    """The renderer's AO over its whole range, both ends (0: nothing visible, 1: nothing occluded) included."""
+    ao = rng.uniform(0.0, 1.0, shape)
+    ao.reshape(-1)[:4] = (0.0, 1.0, 1e-6, 1.0 - 1e-6)
+    return ao
 
 
 def distribution_moments(rng, shape, k=6):
@@ -388,4 +397,6 @@ def material_inputs(material, size=SIZE, seed=21):
     world = world_inputs(size=size, seed=int(rng.integers(1 << 30)))
     for param, name in material.world_inputs.items():
         vals[name] = world[name] if name in world else world[param]
+    for name in material.occlusion_inputs:
+        vals[name] = ambient_occlusion(rng, shape)
     return {k: np.asarray(v, np.float32) for k, v in vals.items()}
