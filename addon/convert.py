@@ -251,7 +251,7 @@ def stored_features(material):
         features = Features.from_dict(data)
         return Features(specular=str(features.specular), diffuse=str(features.diffuse),
                         sheen=str(features.sheen), cloth=bool(features.cloth),
-                        environment_ms=str(features.environment_ms))
+                        environment_ms=str(features.environment_ms), occlusion=str(features.occlusion))
     except (TypeError, ValueError):
         return None
 

@@ -11,7 +11,8 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ..core.materials.rt_lit_interface import DIFFUSE_MODELS, PRINCIPLED_SHEEN, SHEEN_MODELS, SPECULAR_MODELS, Features
+from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, OCCLUSION_MODELS, PRINCIPLED_SHEEN, SHEEN_MODELS,
+                                               SPECULAR_MODELS, Features)
 from . import convert, preferences
 
 # --------------------------------------------------------------------------------------------
@@ -48,9 +49,21 @@ SHEEN_LABELS = {
 SHEEN_ITEMS = tuple((m, *SHEEN_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in SHEEN_MODELS)
 
 
+OCCLUSION_LABELS = {
+    "none": ("None", "The world lights every point as if nothing stood around it"),
+    "lagarde": ("AO + Lagarde", "The renderer's ambient occlusion on the world's diffuse; its specular occluded by "
+                "Lagarde & de Rousiers 2014's fit"),
+    "cones": ("AO + Cones", "The renderer's ambient occlusion on the world's diffuse; its specular occluded by "
+              "Jimenez et al. 2016's cone intersection"),
+    "cones_clipped": ("AO + Clipped Cones", "The renderer's ambient occlusion on the world's diffuse; its specular "
+                      "occluded by the cone intersection within the hemisphere (the most accurate)"),
+}
+OCCLUSION_ITEMS = tuple((m, *OCCLUSION_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in OCCLUSION_MODELS)
+
+
 def draw_switches(layout, owner):
     """The RT Lit switches of ``owner`` (the Convert dialog, or a material's ``rtl_switches``): specular,
-    the world form (active for Fdez-Aguera), diffuse, sheen and cloth."""
+    the world form (active for Fdez-Aguera), diffuse, sheen, cloth and the world's occlusion."""
     layout.prop(owner, "specular")
     sub = layout.row()
     sub.active = owner.specular == 'fdez_aguera'
@@ -58,6 +71,7 @@ def draw_switches(layout, owner):
     layout.prop(owner, "diffuse")
     layout.prop(owner, "sheen")
     layout.prop(owner, "cloth")
+    layout.prop(owner, "occlusion")
 
 
 # --------------------------------------------------------------------------------------------
@@ -144,6 +158,9 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
         items=ENVIRONMENT_MS_ITEMS,
         default=Features().environment_ms,
     )
+    occlusion: EnumProperty(name="World Occlusion",
+                            description="How the scene occludes the world's light (Cycles' and EEVEE's Ambient "
+                                        "Occlusion node feeds it)", items=OCCLUSION_ITEMS, default=Features().occlusion)
 
     @classmethod
     def poll(cls, context):
@@ -154,7 +171,7 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
 
     def features(self):
         return Features(specular=self.specular, diffuse=self.diffuse, sheen=self.sheen, cloth=self.cloth,
-                        environment_ms=self.environment_ms)
+                        environment_ms=self.environment_ms, occlusion=self.occlusion)
 
     def invoke(self, context, event):
         material = _active_material(context)
@@ -162,7 +179,7 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
         if stored is not None:
             self.specular, self.diffuse = stored.specular, stored.diffuse
             self.sheen, self.cloth = stored.sheen, stored.cloth
-            self.environment_ms = stored.environment_ms
+            self.environment_ms, self.occlusion = stored.environment_ms, stored.occlusion
         else:
             if self.sheen == "none" and convert.principled_uses_sheen(material):
                 self.sheen = PRINCIPLED_SHEEN

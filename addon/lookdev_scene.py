@@ -176,15 +176,16 @@ def configure_lookdev_render(scene, view_transform="AgX", samples=16):
     scene.view_settings.look = "None"
 
 
-#: The floor's material and switches: grey, rough, the cheapest lobes.
+#: The floor's material and switches: grey, rough, the cheapest lobes (and the scene's world occlusion).
 FLOOR_VALUES = {"Base Color": (0.5, 0.5, 0.5, 1.0), "Roughness": 0.8, "Metallic": 0.0}
 FLOOR_FEATURES = {"specular": "single", "diffuse": "lambert"}
 #: With a floor the camera looks down by this much (radians), so the floor is seen.
 FLOOR_CAMERA_TILT = math.radians(15.0)
 
 
-def _floor(name, collection, z, lut_dir, scene):
-    """A 9 x 5 m plane under the spheres with an RT Lit material (where RT Lit's missing shadows show)."""
+def _floor(name, collection, z, lut_dir, scene, occlusion="none"):
+    """A 9 x 5 m plane under the spheres with an RT Lit material (where RT Lit's missing shadows show), its world
+    occluded as ``occlusion`` says (``Features.occlusion``)."""
     import bmesh
 
     from ..core.materials.rt_lit_interface import Features
@@ -192,7 +193,7 @@ def _floor(name, collection, z, lut_dir, scene):
 
     mat = principled_material(f"{name} Floor", FLOOR_VALUES)
     convert.principled_to_rt_lit(mat, lambda f: materials.ensure_rt_lit_group(f, scene, lut_dir),
-                                 Features(**FLOOR_FEATURES))
+                                 Features(**FLOOR_FEATURES, occlusion=occlusion))
     mesh = bpy.data.meshes.new(f"{name} Floor")
     bm = bmesh.new()
     bmesh.ops.create_grid(bm, x_segments=1, y_segments=1, size=1.0)
@@ -262,7 +263,7 @@ def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world
     scene.camera = cam
     if floor:
         bottom = 0.5 * SPACING * (len(ROWS) - 1) - (len(ROWS) - 1) * SPACING - RADIUS
-        _floor(name, collection, bottom, lut_dir, scene)
+        _floor(name, collection, bottom, lut_dir, scene, features.occlusion)
     return scene
 
 

@@ -34,6 +34,10 @@ from .light_model import light_kind
 
 #: Geometry node output feeding each geometry input of the material function.
 _GEOMETRY_SOCKETS = {"Position": "Position", "Geometry Normal": "Normal", "Incoming": "Incoming"}
+#: The Ambient Occlusion node's Distance (m) in RT Lit trees with world occlusion on: far enough that the objects of
+#: a lookdev set-up occlude one another's sky as path tracing sees it, near enough that an open scene's far
+#: geometry does not.  Cycles traces its rays (the node's samples: 16); EEVEE estimates AO from its own horizon scan.
+AO_DISTANCE = 10.0
 #: Driver sources that are not in "RTL Scene Lights": the linking option's per-object attribute.
 _PER_OBJECT_SOURCES = ("excluded",)
 
@@ -227,6 +231,17 @@ class _TreeInputs:
             return self._node("geometry", nodes, new).outputs[output]
         return make
 
+    def ambient_occlusion(self):
+        """The AO output of an Ambient Occlusion node (``AO_DISTANCE``, the shading normal: its Normal unlinked)."""
+        def make(nodes, links):
+            def new(nodes):
+                node = nodes.new("ShaderNodeAmbientOcclusion")
+                node.inputs["Distance"].default_value = AO_DISTANCE
+                node.location = (-400.0, 600.0)
+                return node
+            return self._node("ambient occlusion", nodes, new).outputs["AO"]
+        return make
+
     def attribute(self, name, inverted, y):
         """The Fac output of an Attribute node (Object type) reading ``name`` (an object's custom property, 0
         where the object has none), or 1 - Fac when ``inverted``."""
@@ -314,6 +329,7 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
                                  inputs.group("lights", SCENE_LIGHTS_GROUP, -200.0, light_input(shaded[k], param)))
                              for param, n in per_light.items()})
         internal.update({n: inputs.group("world", WORLD_GROUP, -600.0, n) for n in material.world_inputs.values()})
+        internal.update({n: inputs.ambient_occlusion() for n in material.occlusion_inputs})
         trees[engine], _ = node_emit.ensure_tree(f"{name} [{engine}]", material.function,
                                                  material.material_inputs, sockets=(RT_LIT_INPUTS, RT_LIT_OUTPUTS),
                                                  internal_inputs=internal,

@@ -16,7 +16,8 @@ from ..core.materials.rt_lit_interface import Features
 from . import convert, convert_ui
 
 _ENUMS = {"specular": convert_ui.SPECULAR_ITEMS, "diffuse": convert_ui.DIFFUSE_ITEMS,
-          "environment_ms": convert_ui.ENVIRONMENT_MS_ITEMS, "sheen": convert_ui.SHEEN_ITEMS}
+          "environment_ms": convert_ui.ENVIRONMENT_MS_ITEMS, "sheen": convert_ui.SHEEN_ITEMS,
+          "occlusion": convert_ui.OCCLUSION_ITEMS}
 
 
 def _features(material):
@@ -60,6 +61,7 @@ class RTL_PG_switches(bpy.types.PropertyGroup):
     sheen: _enum("sheen", "Sheen")
     cloth: BoolProperty(name="Cloth", get=_getter("cloth"), set=_setter("cloth"))
     environment_ms: _enum("environment_ms", "World Multiscattering")
+    occlusion: _enum("occlusion", "World Occlusion")
 
 
 classes = (RTL_PG_switches,)

@@ -67,7 +67,9 @@ def test_shade_world_groups_match_numpy(empty_scene, tables, environment):
     for features in (Features("fdez_aguera", "cod", sheen=True, cloth=True),
                      Features("kulla_conty", "wrapped"), Features("single", "lambert"),
                      Features("turquin", "oren_nayar"),
-                     Features("turquin", "cod", sheen="zeltner"), Features("none", "lambert", sheen="disney_fitted")):
+                     Features("turquin", "cod", sheen="zeltner"), Features("none", "lambert", sheen="disney_fitted"),
+                     Features("turquin", "cod", cloth=True, sheen="zeltner", occlusion="cones_clipped"),
+                     Features("fdez_aguera", "oren_nayar", occlusion="lagarde"), Features("single", "cod", occlusion="cones")):
         fn = world.shade_world_function(features, env)
         _check(fn, tables)
         counts = node_emit.tree_node_counts(node_emit.ensure_function_group(fn, tables))

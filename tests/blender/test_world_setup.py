@@ -462,3 +462,53 @@ def test_rt_lit_rebuilds_from_the_packed_image_when_the_cache_is_gone(bpy_module
     bpy.data.images.remove(bpy.data.images[f"RTL_{record['table']}"])
     with pytest.raises(RuntimeError, match="Sync RT Lit World again"):
         world_mod.world_environment()
+
+
+def test_world_occlusion_reads_cycles_ambient_occlusion(bpy_module, world_mod, small, lut_dir, tmp_path):
+    """World occlusion (``Features.occlusion``, issue 29): each engine tree of an occluded RT Lit material takes
+    the "Ambient Occlusion" input from an Ambient Occlusion node.  Rendered by Cycles, a floor open to the sky
+    (the AO rays all miss: AO = 1) looks exactly as without occlusion, and the same floor inside a closed box
+    (every ray hits: AO = 0) receives nothing from the world, where the unoccluded material still shows it."""
+    bpy = bpy_module
+    from rt_lookdev.addon import materials
+    from rt_lookdev.core.materials.rt_lit_interface import OCCLUSION_INPUT, Features
+    from rt_lookdev.validation.harness.engines import render_engines
+
+    scene = bpy.context.scene
+    _world(bpy, scene, _image(bpy, "env", _environment()))
+    world_mod.sync_world(scene, tmp_path, settings=small)
+    mesh = bpy.data.meshes.new("floor")
+    mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+    floor = bpy.data.objects.new("floor", mesh)
+    scene.collection.objects.link(floor)
+    mat = bpy.data.materials.new("rt occluded")
+    floor.data.materials.append(mat)
+    camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    camera.location = (0.0, -0.6, 1.2)
+    camera.rotation_euler = (0.45, 0.0, 0.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+
+    def render(features):
+        materials.assign_rt_lit(mat, features, scene=scene, lut_dir=lut_dir)
+        return render_engines(scene, ("CYCLES",), resolution=12, samples=1)["CYCLES"][0]
+
+    occluded = Features("turquin", "cod", occlusion="cones_clipped")
+    open_plain, open_occluded = render(Features("turquin", "cod")), render(occluded)
+    ng = mat.node_tree.nodes[materials.RT_LIT_NODE_NAME].node_tree
+    for engine, *_ in materials.ENGINE_TREES:
+        tree = ng.nodes[engine].node_tree
+        ao = [n for n in tree.nodes if n.bl_idname == "ShaderNodeAmbientOcclusion"]
+        assert len(ao) == 1 and ao[0].outputs["AO"].is_linked, engine
+        assert ao[0].inputs["Distance"].default_value == materials.AO_DISTANCE
+        assert any(link.to_socket.name == OCCLUSION_INPUT for link in tree.links if link.from_node == ao[0]), engine
+    assert open_plain.min() > 0.05
+    np.testing.assert_allclose(open_occluded, open_plain, rtol=1e-5, atol=1e-7)
+
+    box = bpy.data.meshes.new("box")             # a closed box around the floor and the camera
+    box.from_pydata([(x, y, z) for x in (-3, 3) for y in (-3, 3) for z in (-1, 3)], [],
+                    [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)])
+    scene.collection.objects.link(bpy.data.objects.new("box", box))
+    boxed_occluded, boxed_plain = render(occluded), render(Features("turquin", "cod"))
+    np.testing.assert_allclose(boxed_plain, open_plain, rtol=1e-6)      # the unoccluded material ignores the box
+    assert boxed_occluded.max() <= 1e-6
