@@ -110,8 +110,9 @@ def sphere_errors(a, reference_pair, index, names):
     return out
 
 
-def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee=True, log=print):
-    """Measure the lookdev ``scene`` against its ``twin`` (module doc); returns a JSON-able dict."""
+def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee=True, log=print, rt_lit_samples=1):
+    """Measure the lookdev ``scene`` against its ``twin`` (module doc); returns a JSON-able dict.  ``rt_lit_samples``:
+    Cycles samples of (a), 1 unless its materials trace something (world occlusion's Ambient Occlusion node)."""
     from ...addon import lookdev_scene
 
     spheres = lookdev_scene.lookdev_spheres(scene)
@@ -124,8 +125,8 @@ def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee
     result = {"resolution": list(resolution), "samples": samples, "seeds": list(seeds),
               "bounces": twin.cycles.max_bounces, "spheres": names}
     with tempfile.TemporaryDirectory(prefix="rtl-twin-") as tmp:
-        a, index, t_a = render_measurement(scene, resolution, 1, 0, tmp)
-        log(f"[twin] RT Lit (Cycles, 1 sample): {t_a:.2f} s")
+        a, index, t_a = render_measurement(scene, resolution, rt_lit_samples, 0, tmp)
+        log(f"[twin] RT Lit (Cycles, {rt_lit_samples} sample{'s' if rt_lit_samples > 1 else ''}): {t_a:.2f} s")
         refs, times = [], []
         for seed in seeds:
             ref, ref_index, t = render_measurement(twin, resolution, samples, seed, tmp)
@@ -262,27 +263,43 @@ def write_pictures(result, folder, prefix="lookdev_"):
     return paths
 
 
-def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print):
+#: Cycles samples of the RT Lit render when its materials trace the world's occlusion (16 AO rays each).
+OCCLUSION_SAMPLES = 32
+
+
+def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, features=None, lights=True):
     """The lookdev scene with its floor (``new_lookdev_scene(floor=True)``) against its twin: how much of the
-    floor the spheres shadow in path tracing, and the error that leaves on it (RT Lit casts no shadows)."""
+    floor the spheres shadow in path tracing, and the error that leaves on it.  ``features``: the RT Lit
+    switches of every material (default ``Features()``: nothing occluded); with world occlusion on, the RT Lit
+    render takes ``OCCLUSION_SAMPLES``.  ``lights``: False removes the studio lights (the world alone)."""
     import bpy
 
-    from ...addon import lookdev_scene
+    from ...addon import light_sync, lookdev_scene
+    from ...core.materials.rt_lit_interface import Features
 
+    features = features or Features()
     bpy.ops.wm.read_homefile(use_empty=True)
-    scene = lookdev_scene.new_lookdev_scene("Floor Study", view_transform="Standard", lut_dir=lut_dir, floor=True)
+    scene = lookdev_scene.new_lookdev_scene("Floor Study", features, view_transform="Standard", lut_dir=lut_dir,
+                                            floor=True)
+    if not lights:
+        for obj in [o for o in scene.objects if o.type == "LIGHT"]:
+            bpy.data.objects.remove(obj)
+        light_sync.sync_lights(scene, lut_dir)
     twin = lookdev_scene.add_path_traced_twin(scene)
-    result = compare(scene, twin, resolution, samples, eevee=False, log=log)
+    result = compare(scene, twin, resolution, samples, eevee=False, log=log,
+                     rt_lit_samples=1 if features.occlusion == "none" else OCCLUSION_SAMPLES)
     floor = f"{scene.name} Floor"
     index = result["spheres"].index(floor) + 1
-    out = {"resolution": list(resolution), "samples": samples,
+    out = {"resolution": list(resolution), "samples": samples, "features": features.label(), "lights": lights,
            "floor_with_shadows": result["with_shadows"].get(floor), "floor_without_shadows": result["without_shadows"].get(floor),
-           "shadowed_fraction_all": result["shadowed_fraction"], "images": result["images"]}
+           "shadowed_fraction_all": result["shadowed_fraction"], "images": result["images"],
+           "seconds": result["seconds"], "rt_lit_samples": 1 if features.occlusion == "none" else OCCLUSION_SAMPLES}
     shadowed = result["images"]["path_traced"].max(axis=-1)
     free = result["images"]["path_traced_no_shadows"].max(axis=-1)
     floor_mask = _floor_mask(result, index)
     darkened = (free - shadowed)[floor_mask] / np.maximum(free[floor_mask], 1e-12)
     out["floor_shadowed_fraction"] = float((darkened > 0.05).mean()) if darkened.size else 0.0
+    out["floor_mask"] = floor_mask          # (H, W) bool: the floor pixels compared (not JSON: ``run`` drops it)
     log(f"[twin] floor study: {out['floor_shadowed_fraction']:.1%} of the floor darkened > 5% by shadows; floor "
         f"median error {out['floor_with_shadows']['median']:.2%} with, {out['floor_without_shadows']['median']:.2%} "
         "without the shadows")
@@ -323,6 +340,7 @@ def run(out_dir, lut_dir=None, resolution=(320, 160), samples=256, eevee=True, p
         write_pictures(result, pictures_dir)
         write_pictures(floor, pictures_dir, prefix="lookdev_floor_")
     floor.pop("images")
+    floor.pop("floor_mask")
     result["floor"] = floor
     result["pictures"] = [p.name for p in pictures]
     images = result.pop("images")
