@@ -1,0 +1,130 @@
+"""Light shadows on RT Lit (addon/shadows.py): Heitz, Hill & McGuire 2018's ratio estimator in a Cycles F12
+render.  A floor under a box that hangs in the air (seen by shadow rays only, so the camera looking straight down
+sees the floor's shadow): the umbra goes dark, the lit floor keeps the RT Lit value, two lights are shadowed each by
+its own ratio; disable removes everything; the setup survives save and reload."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from rt_lookdev.validation.harness import exr_images
+from rt_lookdev.validation.harness.render_setup import configure_cycles_measurement
+
+pytest.importorskip("OpenEXR")
+
+pytestmark = pytest.mark.blender
+
+RES = 48                    # pixels; the camera sees the floor square [-2, 2]^2
+HALF = 2.0
+BOX = (0.0, 0.0, 1.0)       # the occluder's centre; half size 0.3
+BOX_HALF = 0.3
+
+
+def _pixel_xy():
+    """World (x, y) of each pixel centre of the top-down orthographic camera (row 0 = top = +y)."""
+    c = -HALF + (np.arange(RES) + 0.5) * 2 * HALF / RES
+    return np.meshgrid(c, -c)
+
+
+def _scene(bpy, lut_dir, lights):
+    """Floor (RT Lit), a box occluder at ``BOX`` (invisible to the camera), ``lights`` [(name, type, location,
+    power, size)] in a collection of their own, an orthographic camera straight down; lights synced."""
+    from rt_lookdev.addon import light_sync, materials
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    scene = bpy.context.scene
+    configure_cycles_measurement(scene, samples=4, seed=3, threads=2)
+    scene.cycles.max_bounces = 0
+    world = bpy.data.worlds.new("Black")
+    world.color = (0.0, 0.0, 0.0)
+    scene.world = world
+    r = scene.render
+    r.resolution_x = r.resolution_y = RES
+    r.resolution_percentage = 100
+    r.dither_intensity = 0.0
+    bpy.ops.mesh.primitive_plane_add(size=2 * HALF + 1.0)
+    floor = bpy.context.object
+    floor.name = "Floor"
+    bpy.ops.mesh.primitive_cube_add(size=2 * BOX_HALF, location=BOX)
+    box = bpy.context.object
+    box.name = "Box"
+    box.visible_camera = False
+    collection = bpy.data.collections.new("Lights")
+    scene.collection.children.link(collection)
+    for name, kind, location, power, size in lights:
+        data = bpy.data.lights.new(name, kind)
+        data.energy = power
+        if kind == "AREA":
+            data.size = size
+        else:
+            data.shadow_soft_size = size
+        obj = bpy.data.objects.new(name, data)
+        obj.location = location
+        collection.objects.link(obj)
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 2 * HALF
+    camera.location = (0.0, 0.0, 6.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    light_sync.sync_lights(scene, lut_dir)
+    material = bpy.data.materials.new("Floor RT Lit")
+    materials.assign_rt_lit(material, Features(), scene=scene, lut_dir=lut_dir)
+    material.node_tree.nodes["RT Lit"].inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+    floor.data.materials.append(material)
+    box.data.materials.append(material)
+    return scene
+
+
+def _render(bpy, scene, path):
+    """{"final": the composited image (or the beauty without shadows), pass name: image} of one F12 render to a
+    multilayer EXR; and the seconds it took."""
+    from rt_lookdev.addon import compat
+
+    compat.set_exr_output(scene.render.image_settings, multilayer=True)
+    scene.render.filepath = str(path)
+    t0 = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    seconds = time.perf_counter() - t0
+    ch = exr_images.read_channels(path)
+    out = {}
+    for key in ch:
+        layer, name, c = key.rsplit(".", 2) if key.count(".") >= 2 else ("", *key.split("."))
+        if c == "R":
+            out[f"{layer}.{name}"] = np.stack([ch[f"{layer}.{name}.{k}"] for k in "RGB"], axis=-1)
+    out["final"] = out.get("Composite.Combined", out.get(f"{scene.view_layers[0].name}.Combined"))
+    return out, seconds
+
+
+def _regions():
+    x, y = _pixel_xy()
+    far = np.maximum(np.abs(x), np.abs(y))
+    return far < 0.25, (far > 0.95) & (far < 1.9)    # umbra of a light above the box, fully lit floor
+
+
+def test_umbra_is_dark_and_lit_floor_keeps_rt_lit(empty_scene, lut_dir, tmp_path):
+    import bpy
+
+    from rt_lookdev.addon import shadows
+
+    scene = _scene(bpy, lut_dir, [("Key", "AREA", (0.0, 0.0, 3.0), 300.0, 0.4)])
+    plain, t_plain = _render(bpy, scene, tmp_path / "plain.exr")
+    shadows.enable_shadows(scene)
+    assert shadows.shadows_enabled(scene)
+    shaded, t_shadows = _render(bpy, scene, tmp_path / "shadows.exr")
+    ref, got = plain["final"], shaded["final"]
+    assert np.all(np.isfinite(got))
+    umbra, lit = _regions()
+    level = ref[lit].mean()
+    assert level > 0.1 and ref[umbra].min() > 0.5 * level           # unshadowed RT Lit lights the umbra
+    rel = np.abs(got - ref)[lit] / ref[lit]
+    print(f"umbra max {got[umbra].max() / level:.3g} of the lit level; lit rel. error median "
+          f"{np.median(rel):.3g}, max {rel.max():.3g}; F12 {t_plain:.2f} s without, {t_shadows:.2f} s with shadows")
+    assert got[umbra].max() < 0.01 * level
+    assert np.median(rel) < 2e-3 and rel.max() < 0.03
+    # the beauty layer's Combined is the unshadowed render, and its AOV is that light's part
+    beauty = f"{scene.view_layers[0].name}"
+    np.testing.assert_allclose(shaded[f"{beauty}.Combined"], ref, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(shaded[f"{beauty}.RTL Light 0"], ref, rtol=1e-4, atol=1e-6)
