@@ -91,16 +91,16 @@ def enable_shadows(scene, samples=4, denoise=True, view_layer=None):
     rebuilds everything (the same result).  Raises ``ShadowError`` (changing nothing) when the scene renders with
     another engine, has no synced light, or has a compositor of its own."""
     settings = shadow_settings(scene)
-    if settings is not None:
-        view_layer = view_layer or settings["beauty"]
-        disable_shadows(scene)
-    beauty = _beauty_layer(scene, view_layer)
-    lights = _synced_lights(scene)
     if scene.render.engine != "CYCLES":
         raise ShadowError(f"RT Lit shadows need Cycles (the scene renders with {scene.render.engine})")
-    if compat.compositor_tree(scene) is not None:
+    tree = compat.compositor_tree(scene)
+    if tree is not None and not tree.get(SHADOWS_KEY):
         raise ShadowError("The scene has a compositor of its own; RT Lit shadows build theirs and do not edit another "
                           "one: remove it (or its nodes) first")
+    lights = _synced_lights(scene)
+    beauty = _beauty_layer(scene, view_layer or (settings["beauty"] if settings is not None else None))
+    if settings is not None:
+        disable_shadows(scene)
     scene[SHADOWS_KEY] = {"samples": int(samples), "denoise": bool(denoise), "beauty": beauty.name,
                           "use_compositing": bool(scene.render.use_compositing), "aovs": []}
     try:
@@ -146,10 +146,10 @@ def disable_shadows(scene):
     bpy.data.batch_remove(copies)
     bpy.data.batch_remove(data)
     bpy.data.batch_remove([c for c in bpy.data.collections if c.get(SHADOW_COPY_KEY) == scene.name])
-    material = bpy.data.materials.get(PROBE_MATERIAL)
-    if material is not None and material.users == 0:
-        bpy.data.materials.remove(material)
     del scene[SHADOWS_KEY]
+    material = bpy.data.materials.get(PROBE_MATERIAL)
+    if material is not None and not any(shadows_enabled(other) for other in bpy.data.scenes):
+        bpy.data.materials.remove(material)
 
 
 # --- the parts ----------------------------------------------------------------------------------------------------
