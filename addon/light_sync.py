@@ -104,7 +104,7 @@ def sync_lights(scene, lut_dir=None):
     except Exception as ex:
         raise _failed(scene, ex, lut_dir) from ex
     _failures.pop(scene.name, None)
-    shadows.refresh_shadows(scene)         # the shadow probes' light copies follow the synced lights
+    shadows.refresh_shadows(scene, lut_dir)      # the shadow probes' light copies follow the synced lights
     return records, groups
 
 

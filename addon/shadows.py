@@ -32,7 +32,9 @@ divide").  Here, in one F12 render (``bpy.ops.render.render``), measured by the 
   horizon or outside its cone) the ratio falls back to 1, and a denoised S above U counts as unshadowed.
 
 A scene that already has a compositor is refused (``ShadowError``): this module does not edit a graph it did not
-make.  ``disable_shadows`` removes everything ``enable_shadows`` made; Sync Lights rebuilds the copies
+make.  The AOV nodes are in the RT Lit Cycles trees only while shadows are on (the groups are rebuilt on enable and
+disable): EEVEE compiles an AOV node's inputs whatever the Material Output's target (``materials.AOV_ENGINES``), so
+while shadows are on, render with Cycles.  ``disable_shadows`` removes everything ``enable_shadows`` made; Sync Lights rebuilds the copies
 (``light_sync.sync_lights`` calls ``refresh_shadows``).  Cycles only: EEVEE renders the probe layers but writes no
 light-group passes (EEVEE's own Shadow pass is the way there, not built yet).
 """
@@ -40,11 +42,10 @@ from __future__ import annotations
 
 import bpy
 
-from . import compat, materials
-from .common import SHADOW_COPY_KEY, light_aov_name
+from pathlib import Path
 
-#: Custom property of the scene holding the shadow settings while shadows are on (``shadows_enabled``).
-SHADOWS_KEY = "rtl_shadows"
+from . import compat, materials, preferences
+from .common import SHADOW_COPY_KEY, SHADOWS_KEY, light_aov_name, node_groups_kept_on_error
 #: The probe view layers: (role, view layer name, collection of the light copies, light-group prefix, shadowed).
 PROBES = (("S", "RTL Probe S", "RTL Shadow Lights S", "s_", True),
           ("U", "RTL Probe U", "RTL Shadow Lights U", "u_", False))
@@ -82,14 +83,20 @@ def light_group_name(role, index):
     return f"{prefix}{index}"
 
 
-def enable_shadows(scene, samples=4, denoise=True, view_layer=None):
+def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None):
     """Shadow RT Lit materials in ``scene``'s Cycles renders (Heitz et al. 2018's ratio estimator; module docstring).
 
     ``samples``: the probe layers' samples per pixel; ``denoise``: Open Image Denoise on each S and U pass;
     ``view_layer``: the name of the view layer whose render is shadowed (default: the first one that renders).
-    The lights are those of the last light sync (``materials.synced_light_kinds``, the AOVs' indices).  Enabling again
-    rebuilds everything (the same result).  Raises ``ShadowError`` (changing nothing) when the scene renders with
-    another engine, has no synced light, or has a compositor of its own."""
+    The lights are those of the last light sync (``materials.synced_light_kinds``, the AOVs' indices).  The RT Lit
+    groups are rebuilt with the lights' AOVs in their Cycles trees (``materials.AOV_ENGINES``; ``lut_dir``: the
+    tables, default the preferences').  Enabling again rebuilds everything (the same result).  Raises ``ShadowError``
+    (changing nothing) when the scene renders with another engine, has no synced light, or has a compositor of its
+    own."""
+    _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups=True)
+
+
+def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups):
     settings = shadow_settings(scene)
     if scene.render.engine != "CYCLES":
         raise ShadowError(f"RT Lit shadows need Cycles (the scene renders with {scene.render.engine})")
@@ -99,33 +106,58 @@ def enable_shadows(scene, samples=4, denoise=True, view_layer=None):
                           "one: remove it (or its nodes) first")
     lights = _synced_lights(scene)
     beauty = _beauty_layer(scene, view_layer or (settings["beauty"] if settings is not None else None))
+    use_compositing = bool(scene[SHADOWS_KEY]["use_compositing"]) if settings is not None \
+        else bool(scene.render.use_compositing)
     if settings is not None:
-        disable_shadows(scene)
+        _remove_parts(scene)
     scene[SHADOWS_KEY] = {"samples": int(samples), "denoise": bool(denoise), "beauty": beauty.name,
-                          "use_compositing": bool(scene.render.use_compositing), "aovs": []}
+                          "use_compositing": use_compositing, "aovs": []}
     try:
         _build(scene, beauty, lights, int(samples), bool(denoise))
+        if rebuild_groups:              # the AOVs in the RT Lit Cycles trees (kept when they are there)
+            _rebuild_groups(scene, lut_dir)
     except BaseException:
-        disable_shadows(scene)
+        disable_shadows(scene, lut_dir)
         raise
 
 
-def refresh_shadows(scene):
-    """After a light sync: rebuild the light copies and the compositor for the synced lights (when shadows are on);
-    returns whether it did."""
+def refresh_shadows(scene, lut_dir=None):
+    """After a light sync (which built the RT Lit groups with the AOVs): rebuild the light copies and the compositor
+    for the synced lights when shadows are on; returns whether it did."""
     settings = shadow_settings(scene)
     if settings is None:
         return False
-    enable_shadows(scene, settings["samples"], settings["denoise"], settings["beauty"])
+    _enable(scene, settings["samples"], settings["denoise"], settings["beauty"], lut_dir, rebuild_groups=False)
     return True
 
 
-def disable_shadows(scene):
+def disable_shadows(scene, lut_dir=None):
     """Remove what ``enable_shadows`` made: the probe view layers, the light copies and their data, collections and
-    light groups, the AOVs it declared, the probe material and the compositor; the scene is as before."""
-    stored = scene.get(SHADOWS_KEY)
-    if stored is None:
+    light groups, the AOVs it declared, the probe material and the compositor, and the AOV nodes of the RT Lit
+    Cycles trees (the groups rebuilt; ``lut_dir`` as ``enable_shadows``); the scene is as before."""
+    if SHADOWS_KEY not in scene:
         return
+    _remove_parts(scene)
+    del scene[SHADOWS_KEY]
+    material = bpy.data.materials.get(PROBE_MATERIAL)
+    if material is not None and not any(shadows_enabled(other) for other in bpy.data.scenes):
+        bpy.data.materials.remove(material)
+    _rebuild_groups(scene, lut_dir)
+
+
+def _rebuild_groups(scene, lut_dir):
+    """Rebuild the RT Lit groups (all or nothing, as a light sync): with the lights' AOVs while ``scene`` has shadows
+    on, without them after."""
+    if not materials.has_rt_lit_groups():
+        return
+    lut_dir = Path(lut_dir) if lut_dir is not None else preferences.lut_directory()
+    with node_groups_kept_on_error():
+        materials.rebuild_rt_lit_groups(scene, lut_dir)
+
+
+def _remove_parts(scene):
+    """Remove the view layers, light copies, AOVs and compositor of ``enable_shadows`` (not the settings)."""
+    stored = scene[SHADOWS_KEY]
     tree = compat.compositor_tree(scene)
     if tree is not None and tree.get(SHADOWS_KEY):
         del tree[SHADOWS_KEY]
@@ -146,10 +178,6 @@ def disable_shadows(scene):
     bpy.data.batch_remove(copies)
     bpy.data.batch_remove(data)
     bpy.data.batch_remove([c for c in bpy.data.collections if c.get(SHADOW_COPY_KEY) == scene.name])
-    del scene[SHADOWS_KEY]
-    material = bpy.data.materials.get(PROBE_MATERIAL)
-    if material is not None and not any(shadows_enabled(other) for other in bpy.data.scenes):
-        bpy.data.materials.remove(material)
 
 
 # --- the parts ----------------------------------------------------------------------------------------------------

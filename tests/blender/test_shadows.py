@@ -182,6 +182,8 @@ def _state(bpy, scene):
             "objects": names(bpy.data.objects), "lights": names(bpy.data.lights),
             "collections": names(bpy.data.collections), "materials": names(bpy.data.materials),
             "node groups": names(bpy.data.node_groups), "compositor": compat.compositor_tree(scene) is not None,
+            "aov nodes": sorted(n.aov_name for ng in bpy.data.node_groups if ng.bl_idname == "ShaderNodeTree"
+                                for n in ng.nodes if n.bl_idname == "ShaderNodeOutputAOV"),
             "use_compositing": scene.render.use_compositing, "properties": sorted(scene.keys())}
 
 
@@ -197,6 +199,7 @@ def test_disable_removes_everything_enable_is_idempotent_and_reload_renders(empt
     once = _state(bpy, scene)
     assert set(once["view layers"]) - set(before["view layers"]) == {"RTL Probe S", "RTL Probe U"}
     assert len(once["objects"]) == len(before["objects"]) + 2 and once["compositor"]
+    assert not before["aov nodes"] and once["aov nodes"] == ["RTL Light 0"]     # in the Cycles tree only
     shadows.enable_shadows(scene, samples=2)
     assert _state(bpy, scene) == once
     light_sync.sync_lights(scene, lut_dir)                  # Sync Lights rebuilds the copies: the same state
