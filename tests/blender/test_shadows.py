@@ -235,3 +235,27 @@ def test_disable_removes_everything_enable_is_idempotent_and_reload_renders(empt
     shadows.disable_shadows(scene)
     assert not shadows.shadows_enabled(scene) and _state(bpy, scene) == before
     shadows.disable_shadows(scene)                          # nothing to do
+
+
+def test_copies_follow_their_light_and_stay_in_their_layer(empty_scene, lut_dir):
+    import bpy
+
+    from rt_lookdev.addon import shadows
+
+    scene = _scene(bpy, lut_dir, [("Key", "AREA", (0.0, 0.0, 3.0), 300.0, 0.4)])
+    shadows.enable_shadows(scene)
+    key = scene.objects["Key"]
+    key.location = (0.5, 0.2, 2.5)
+    key.data.size, key.data.energy = 0.9, 77.0
+    seen = {}
+    for layer in scene.view_layers:
+        with bpy.context.temp_override(view_layer=layer):
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+        depsgraph.update()
+        seen[layer.name] = {o.name: (tuple(round(v, 5) for v in o.matrix_world.translation), round(o.data.size, 5),
+                                     round(o.data.energy, 3), o.data.use_shadow, o.lightgroup)
+                            for o in depsgraph.objects if o.type == "LIGHT"}
+    moved = ((0.5, 0.2, 2.5), 0.9, 77.0)
+    assert seen == {"ViewLayer": {"Key": (*moved, True, "")},           # the originals: in the user's layer only
+                    "RTL Probe S": {"Key (s_0)": (*moved, True, "s_0")},
+                    "RTL Probe U": {"Key (u_0)": (*moved, False, "u_0")}}
