@@ -50,11 +50,20 @@ SAVED_TARGET_KEY = "rtl_saved_target"
 ADDED_OUTPUT_KEY = "rtl_added_output"
 #: Custom property of a material: its Cycles emission sampling before it became RT Lit.
 SAVED_EMISSION_SAMPLING_KEY = "rtl_saved_emission_sampling"
+#: Shader AOV of the RT Lit Cycles tree holding scene light i's unshadowed radiance: "RTL Light <i>"
+#: (``light_aov_name``; read by the shadow compositor, addon/shadows.py).
+LIGHT_AOV_PREFIX = "RTL Light "
+#: Custom property of a scene with RT Lit shadows on (addon/shadows.py: its settings); its RT Lit Cycles trees then
+#: write the lights' AOVs (``materials.ensure_rt_lit_group``).
+SHADOWS_KEY = "rtl_shadows"
+#: Custom property marking an object or light data that addon/shadows.py made (a shadow probe's light copy):
+#: never a light RT Lit shades.
+SHADOW_COPY_KEY = "rtl_shadow_copy"
 
 __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WORLD_GROUP", "FEATURES_KEY",
            "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "LINKING_KEY", "LIGHTS_SIGNATURE_KEY", "LIGHTS_SUBSET_KEY", "REACH_KEY",
            "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
-           "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "connect_engine_outputs",
+           "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "LIGHT_AOV_PREFIX", "SHADOWS_KEY", "SHADOW_COPY_KEY", "light_aov_name", "connect_engine_outputs",
            "restore_engine_outputs", "not_a_light", "restore_emission_sampling",
            "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "add_expression_driver",
            "socket_value", "active_output", "source_node",
@@ -62,6 +71,11 @@ __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WO
 
 SOCKET_TYPES = {"float": "NodeSocketFloat", "vector": "NodeSocketVector", "color": "NodeSocketColor",
                 "shader": "NodeSocketShader", FLOAT: "NodeSocketFloat", VECTOR: "NodeSocketVector"}
+
+
+def light_aov_name(index):
+    """The Shader AOV carrying scene light ``index``'s RT Lit radiance (Cycles tree)."""
+    return f"{LIGHT_AOV_PREFIX}{index}"
 
 
 def socket_by_identifier(sockets, identifier):

@@ -17,6 +17,12 @@ release, tests run by ``bash scripts/test.sh --matrix``):
   ``world_sync`` decodes 8-bit world images with the formula in every release.
 - 5.0: image output settings have a ``media_type`` ("IMAGE", "MULTI_LAYER_IMAGE") beside ``file_format``;
   before 5.0 the file format alone says it ("OPEN_EXR", "OPEN_EXR_MULTILAYER").
+- 5.0: the compositor is a node group (``scene.compositing_node_group``, a "CompositorNodeTree" whose Group Output
+  "Image" is the result) instead of the scene's embedded ``scene.node_tree`` switched on by ``scene.use_nodes``
+  with a Composite node; the Mix RGB compositor node is gone (the shader Mix node, data type RGBA, serves), and
+  the Denoise node's options became input sockets ("HDR").  Measured with the 4.5.15 and 5.2.3 wheels
+  (addon/shadows.py, tests/blender/test_shadows.py): ``compositor_tree``, ``new_compositor``,
+  ``remove_compositor``, ``mix_colors``, ``new_denoise``.
 
 Renders of the same RT Lit scene (all five light kinds and a studio HDRI world) agree between releases
 to the float32 level, measured 2026-12-01: 5.3.0 equals 5.2.3 bit for bit; 4.5.15 differs from 5.2.3 by
@@ -40,6 +46,8 @@ MINIMUM_VERSION = (4, 5, 0)
 PERMANENT_NODE_TREES = (5, 0, 0)
 #: 5.0 renamed EEVEE back from "EEVEE Next".
 _EEVEE_RENAMED = (5, 0, 0)
+#: 5.0 made the compositor a node group of its own (``scene.compositing_node_group``).
+COMPOSITOR_NODE_GROUPS = (5, 0, 0)
 
 
 def srgb_decoding_error(release=None):
@@ -108,3 +116,78 @@ def set_exr_output(image_settings, multilayer=False):
 def eevee_engine():
     """The ``scene.render.engine`` identifier of EEVEE in this release."""
     return "BLENDER_EEVEE" if version() >= _EEVEE_RENAMED else "BLENDER_EEVEE_NEXT"
+
+
+def compositor_tree(scene):
+    """The scene's compositor node tree, or None: the node group (5.0 on) or the embedded tree (before), the latter
+    only when it has nodes or is switched on."""
+    if version() >= COMPOSITOR_NODE_GROUPS:
+        return scene.compositing_node_group
+    tree = scene.node_tree
+    if tree is None or (not scene.use_nodes and not len(tree.nodes)):
+        return None
+    return tree
+
+
+def new_compositor(scene, name):
+    """An empty compositor for ``scene``, made the one it uses: (tree, the input socket of the final image).
+    5.0 on: a new node group ``name`` with a Group Output "Image"; before: the scene's embedded tree, switched on,
+    emptied, with a Composite node."""
+    if version() >= COMPOSITOR_NODE_GROUPS:
+        tree = bpy.data.node_groups.new(name, "CompositorNodeTree")
+        tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+        scene.compositing_node_group = tree     # Render Layers nodes can only be added after this
+        output = tree.nodes.new("NodeGroupOutput")
+        return tree, output.inputs[0]
+    scene.use_nodes = True
+    tree = scene.node_tree
+    tree.nodes.clear()
+    output = tree.nodes.new("CompositorNodeComposite")
+    return tree, output.inputs["Image"]
+
+
+def remove_compositor(scene, tree):
+    """Undo ``new_compositor``: the node group removed (5.0 on), or the embedded tree emptied and switched off."""
+    if version() >= COMPOSITOR_NODE_GROUPS:
+        if scene.compositing_node_group == tree:
+            scene.compositing_node_group = None
+        bpy.data.node_groups.remove(tree)
+        return
+    tree.nodes.clear()
+    scene.use_nodes = False
+
+
+def mix_colors(tree, a, b, blend, clamp=False):
+    """A compositor node computing ``a <blend> b`` per channel (blend "ADD", "SUBTRACT", "MULTIPLY", "DIVIDE"),
+    clamped to [0, 1] when ``clamp``; ``a`` is a socket, ``b`` a socket or a constant (r, g, b).  Returns the output
+    socket.  The result's alpha is ``a``'s."""
+    if version() >= COMPOSITOR_NODE_GROUPS:
+        node = tree.nodes.new("ShaderNodeMix")
+        node.data_type = "RGBA"
+        node.blend_type = blend
+        node.clamp_result = clamp
+        node.clamp_factor = True
+        first, second, out = node.inputs[6], node.inputs[7], node.outputs[2]   # A, B (colour), Result (colour)
+    else:
+        node = tree.nodes.new("CompositorNodeMixRGB")
+        node.blend_type = blend
+        node.use_clamp = clamp
+        first, second, out = node.inputs[1], node.inputs[2], node.outputs[0]
+    node.inputs[0].default_value = 1.0                                        # Factor
+    tree.links.new(a, first)
+    if isinstance(b, tuple):
+        second.default_value = (*b, 1.0)
+    else:
+        tree.links.new(b, second)
+    return out
+
+
+def new_denoise(tree, image):
+    """An Open Image Denoise node (HDR input, no albedo or normal) on ``image``; returns its output socket."""
+    node = tree.nodes.new("CompositorNodeDenoise")
+    if "HDR" in node.inputs:
+        node.inputs["HDR"].default_value = True
+    else:
+        node.use_hdr = True
+    tree.links.new(image, node.inputs["Image"])
+    return node.outputs["Image"]

@@ -35,7 +35,7 @@ import numpy as np
 from bpy.app.handlers import persistent
 
 from ..core.lut.exr_io import LutError
-from . import materials, preferences, preset_assets as presets
+from . import materials, preferences, preset_assets as presets, shadows
 from .common import WORLD_GROUP, WORLD_RECORD_KEY, node_groups_kept_on_error
 
 _busy = [False]
@@ -104,6 +104,7 @@ def sync_lights(scene, lut_dir=None):
     except Exception as ex:
         raise _failed(scene, ex, lut_dir) from ex
     _failures.pop(scene.name, None)
+    shadows.refresh_shadows(scene, lut_dir)      # the shadow probes' light copies follow the synced lights
     return records, groups
 
 

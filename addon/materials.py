@@ -27,9 +27,9 @@ from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, R
                                                Features, light_input, rt_lit_group_name)
 from . import compat, light_controls, light_model, node_emit, world_sync
 from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LINKING_KEY, LIGHTS_SIGNATURE_KEY, LIGHTS_SUBSET_KEY, REACH_KEY,
-                     RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP, STAMP_KEY,
-                     WORLD_GROUP, connect_engine_outputs, ensure_interface, not_a_light, remove_drivers, replace_group,
-                     socket_by_identifier)
+                     RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP, SHADOWS_KEY, SHADOW_COPY_KEY, STAMP_KEY,
+                     WORLD_GROUP, connect_engine_outputs, ensure_interface, light_aov_name, not_a_light, remove_drivers,
+                     replace_group, socket_by_identifier)
 from .light_model import light_kind
 
 #: Geometry node output feeding each geometry input of the material function.
@@ -73,9 +73,11 @@ def _included_collections(layer_collection, out=None):
 
 def scene_lights(scene):
     """(object, kind) of every light RT Lit shades: rendered lights (``is_rendered``), in name order
-    (``light_model.light_kind``)."""
+    (``light_model.light_kind``); the shadow probes' light copies (``SHADOW_COPY_KEY``) are not among them."""
     out = []
     for obj in sorted(scene.objects, key=lambda o: o.name):
+        if SHADOW_COPY_KEY in obj:
+            continue                    # a shadow probe's copy of a light (addon/shadows.py)
         kind = light_kind(obj)
         if kind is not None and is_rendered(scene, obj):
             out.append((obj, kind))
@@ -281,6 +283,12 @@ class _TreeInputs:
 #: lookup); EEVEE's picks mipmaps from screen-space derivatives, so its tree writes the filter out as
 #: four Closest fetches (core.ir.tables.bilinear_function).  docs/blender.md, "Per-engine trees".
 ENGINE_TREES = (("Cycles", "CYCLES", "linear", ""), ("EEVEE", "EEVEE", "fetch4", "EEVEE "))
+#: The engine trees that write each light's radiance to a Shader AOV (``common.light_aov_name``) for the shadow
+#: compositor (addon/shadows.py), only while the scene has shadows on (``SHADOWS_KEY``).  Not always: Cycles drops an
+#: AOV node whose AOV no view layer declares, but EEVEE compiles every AOV node's inputs, whatever the Material
+#: Output's target, so the Cycles tree's AOVs put the whole Cycles tree into EEVEE's shader (measured with 5.2.3:
+#: "Uniform block _node_tree too big (66000/65536)" and a wrong image in tests/blender/test_engine_trees.py).
+AOV_ENGINES = ("Cycles",)
 ENGINE_STAMP_KEY = "rtl_engine_trees"
 
 
@@ -303,7 +311,8 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
     """The RT Lit group for ``features`` and the lights of ``scene`` (built or reused): the material
     inputs as its interface, one nested tree per engine (``ENGINE_TREES``) fed by them, and each tree's
     outputs ("Shader", "Radiance" for Cycles; "EEVEE Shader", "EEVEE Radiance").  ``lights``: the indices
-    of the scene's lights it shades (``cull_lights``), default all of them."""
+    of the scene's lights it shades (``cull_lights``), default all of them.  While ``scene`` has shadows on
+    (addon/shadows.py) the Cycles tree also writes each light's radiance to its AOV (``AOV_ENGINES``)."""
     features = features or Features()
     scene = scene or bpy.context.scene
     if bpy.data.node_groups.get(SCENE_LIGHTS_GROUP) is None:
@@ -335,7 +344,10 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
                                                  internal_inputs=internal,
                                                  stamp_extra=repr((records, shaded, world_record and world_record["table"],
                                                                    sorted(linked.items()))),
-                                                 tables=tables, shader_sums={"Shader": list(material.part_outputs)})
+                                                 tables=tables, shader_sums={"Shader": list(material.part_outputs)},
+                                                 aov_outputs=({part: light_aov_name(shaded[k]) for k, part
+                                                               in enumerate(material.part_outputs[1:1 + len(shaded)])}
+                                                              if engine in AOV_ENGINES and SHADOWS_KEY in scene else None))
         material_inputs = material.material_inputs
     ng = _ensure_engine_group(name, trees, material_inputs)
     ng[FEATURES_KEY] = features.as_dict()

@@ -292,7 +292,7 @@ class _Emitter:
 
     # -- one tree ----------------------------------------------------------------------------
     def fill(self, ng, outputs, input_names, sockets=None, kinds=None, internal_inputs=None, description="",
-             shader_sums=None):
+             shader_sums=None, aov_outputs=None):
         """Emit ``outputs`` (name -> Expr of one graph) into the empty tree ``ng``.
 
         ``input_names``: interface inputs, in order; ``sockets``: (inputs, outputs), each
@@ -300,7 +300,9 @@ class _Emitter:
         an output socket inside the tree (e.g. Geometry > Position) instead of an interface input.
         ``shader_sums``: shader output name -> names of colour outputs; each becomes an Emission
         closure (strength 1) and they are summed with Add Shader nodes; those colour outputs are
-        not interface sockets.
+        not interface sockets.  ``aov_outputs``: colour output name -> Shader AOV name; each such output
+        also feeds a Shader AOV node (Cycles writes it where the view layer declares the AOV, and drops the
+        node where none does: addon/shadows.py reads each light's radiance this way).
         """
         in_sockets, out_sockets = sockets or ({}, {})
         kinds, internal_inputs, shader_sums = kinds or {}, internal_inputs or {}, shader_sums or {}
@@ -337,7 +339,22 @@ class _Emitter:
             if node.op not in LEAVES:
                 writer.write(node)
         self._write_outputs(ng, writer, outs, items, shader_sums, hidden)
+        self._write_aovs(ng, writer, dict(outs), aov_outputs or {})
         return ng
+
+    @staticmethod
+    def _write_aovs(ng, writer, outputs, aov_outputs):
+        """One Shader AOV node per entry of ``aov_outputs`` (output name -> AOV name) whose value is not 0."""
+        max_depth = max(writer.depth.values()) if writer.depth else 0
+        for row, (out_name, aov_name) in enumerate(aov_outputs.items()):
+            expr = outputs[out_name]
+            if expr.is_const and not any(expr.attr("value")):
+                continue                          # an AOV never written reads 0
+            aov = ng.nodes.new("ShaderNodeOutputAOV")
+            aov.aov_name = aov_name
+            aov.label = f"AOV {aov_name}"
+            aov.location = ((max_depth + 3) * COLUMN_WIDTH, -(row + 2) * ROW_HEIGHT)
+            writer.feed(aov.inputs["Color"], expr)
 
     def _write_outputs(self, ng, writer, outs, items, shader_sums, hidden):
         """The Group Output node: Emission closures summed per shader output, then the plain outputs."""
@@ -408,15 +425,17 @@ def ensure_function_group(function, tables=None):
 
 
 def ensure_tree(name, function, interface_inputs, sockets=None, internal_inputs=None, stamp_extra="", tables=None,
-                shader_sums=None):
+                shader_sums=None, aov_outputs=None):
     """A named group computing the traced ``function`` (an ``expr.Function``): ``interface_inputs`` become
     its interface (described by ``sockets``, (inputs, outputs) name -> Socket, default the function's),
     the other inputs are produced inside the tree (``internal_inputs``: name -> callable(nodes, links)
-    giving a socket).  Rebuilt only when the function's structure or ``stamp_extra`` changes; returns
-    (group, rebuilt)."""
+    giving a socket).  ``shader_sums`` and ``aov_outputs``: as ``_Emitter.fill``.  Rebuilt only when the function's
+    structure, ``stamp_extra`` or the AOVs change; returns (group, rebuilt)."""
     if not isinstance(function, Function):
         raise TypeError("ensure_tree emits a traced expr.Function")
     stamp = f"{EMITTER_VERSION}:{function.key}:{sorted(interface_inputs)}:{stamp_extra}:{shader_sums!r}"
+    if aov_outputs:
+        stamp += f":aovs {sorted(aov_outputs.items())!r}"
     ng = bpy.data.node_groups.get(name)
     if ng is not None and ng.get(STAMP_KEY) == stamp:
         return ng, False
@@ -431,7 +450,8 @@ def ensure_tree(name, function, interface_inputs, sockets=None, internal_inputs=
         ng.nodes.clear()
     try:
         _Emitter(tables).fill(ng, function.outputs, list(interface_inputs), sockets or function.sockets,
-                              internal_inputs=internal_inputs, description=function.description, shader_sums=shader_sums)
+                              internal_inputs=internal_inputs, description=function.description, shader_sums=shader_sums,
+                              aov_outputs=aov_outputs)
     except BaseException:
         if in_use is not None:          # the group in use stays as it was
             bpy.data.node_groups.remove(ng)
