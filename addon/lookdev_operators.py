@@ -5,10 +5,10 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from . import lookdev_scene, preferences
+from . import lookdev_scene, preferences, shadows
 from .convert_ui import DIFFUSE_ITEMS, SPECULAR_ITEMS
 from .operators import lut_directory_exists
-from ..core.materials.rt_lit_interface import Features
+from ..core.materials.rt_lit_interface import DEFAULT_OCCLUSION, Features
 
 
 def _hdri_items(self, context):
@@ -36,7 +36,10 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
                ("Standard", "Standard", "No tone mapping: the values the measurements compare")),
         default="AgX")
     floor: BoolProperty(name="Floor", default=False,
-                        description="A grey RT Lit floor under the spheres (RT Lit casts no shadows on it)")
+                        description="A grey RT Lit floor under the spheres (shadowed with Shadows on)")
+    shadows: BoolProperty(name="Shadows", default=False,
+                          description="World occlusion on every RT Lit material, and the lights' shadows in Cycles "
+                                      "renders (F12; EEVEE and the viewport stay unshadowed)")
     specular: EnumProperty(name="Specular", items=SPECULAR_ITEMS, default=Features().specular)
     diffuse: EnumProperty(name="Diffuse", items=DIFFUSE_ITEMS, default=Features().diffuse)
 
@@ -56,11 +59,15 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
         if show:
             wm.progress_begin(0, 1)
         try:
+            occlusion = DEFAULT_OCCLUSION if self.shadows else "none"
             scene = lookdev_scene.new_lookdev_scene(
-                self.scene_name or "RT Lookdev", Features(specular=self.specular, diffuse=self.diffuse),
+                self.scene_name or "RT Lookdev", Features(specular=self.specular, diffuse=self.diffuse,
+                                                          occlusion=occlusion),
                 hdri=hdri, world_strength=self.world_strength, view_transform=self.view_transform,
                 lut_dir=preferences.lut_directory(context), floor=self.floor,
                 progress=(lambda done, total: wm.progress_update(done / total)) if show else None)
+            if self.shadows:
+                shadows.enable_shadows(scene, lut_dir=preferences.lut_directory(context))
         except Exception as ex:
             self.report({'ERROR'}, f"Could not build the lookdev scene: {type(ex).__name__}: {ex}")
             return {'CANCELLED'}
@@ -71,7 +78,8 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
             context.window.scene = scene
         spheres = len(lookdev_scene.lookdev_spheres(scene))
         world = f"world '{hdri}'" if hdri else "no world"
-        self.report({'INFO'}, f"Lookdev scene '{scene.name}': {spheres} RT Lit objects, 3 lights, {world}; "
+        shadowed = "; shadows on (Cycles F12)" if self.shadows else ""
+        self.report({'INFO'}, f"Lookdev scene '{scene.name}': {spheres} RT Lit objects, 3 lights, {world}{shadowed}; "
                               "Add > Path-Traced Twin compares it with Cycles path tracing")
         return {'FINISHED'}
 

@@ -32,6 +32,7 @@ import math
 import bpy
 
 from . import compat
+from .common import SHADOW_COPY_KEY
 from .light_model import link_states
 
 #: Sphere roughness along each row.
@@ -474,7 +475,8 @@ def add_path_traced_twin(scene, bounces=0, samples=128):
     cannot take the copies (``_linking_plan``); a twin made before stays until the new one is whole."""
     from .materials import is_rendered
 
-    rendered = [o for o in scene.objects if is_rendered(scene, o)]
+    # the light copies of RT Lit's shadow probes (addon/shadows.py) render in the probe layers only
+    rendered = [o for o in scene.objects if SHADOW_COPY_KEY not in o and is_rendered(scene, o)]
     if not any(uses_rt_lit(o) for o in rendered):
         raise ValueError(f"scene '{scene.name}' renders no RT Lit material to twin")
     plan = _linking_plan(rendered)

@@ -173,6 +173,70 @@ class RTL_OT_sync_lights(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class RTL_OT_enable_shadows(bpy.types.Operator):
+    """Shadow the RT Lit lights in Cycles renders (F12): each light's RT Lit term scaled by a denoised ratio of
+    path-traced shadowed and unshadowed light (Heitz et al. 2018), from two probe view layers and a compositor"""
+
+    bl_idname = "rtl.enable_shadows"
+    bl_label = "Enable RT Lit Shadows"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    samples: bpy.props.IntProperty(name="Shadow Samples", default=4, min=1, max=4096,
+                                   description="Samples of the probe view layers: more is less noise, more time")
+    denoise: bpy.props.BoolProperty(name="Denoise", default=True,
+                                    description="Denoise the shadowed and unshadowed estimates (Open Image Denoise)")
+
+    @classmethod
+    def poll(cls, context):
+        if not _scene_exists(cls, context):
+            return False
+        if context.scene.render.engine != 'CYCLES':
+            cls.poll_message_set("RT Lit shadows are computed by Cycles: set the render engine to Cycles")
+            return False
+        return True
+
+    def execute(self, context):
+        from . import shadows
+
+        try:               # all or nothing: a refused enable changes nothing (shadows.enable_shadows)
+            shadows.enable_shadows(context.scene, self.samples, self.denoise,
+                                   lut_dir=preferences.lut_directory(context))
+        except shadows.ShadowError as ex:
+            self.report({'ERROR'}, str(ex))
+            return {'CANCELLED'}
+        lights = len(shadows.shadowed_lights(context.scene))
+        self.report({'INFO'}, f"RT Lit shadows on: {lights} lights, {self.samples} shadow samples"
+                              f"{', denoised' if self.denoise else ''} (Cycles F12 renders; EEVEE and the viewport "
+                              "stay unshadowed)")
+        return {'FINISHED'}
+
+
+class RTL_OT_disable_shadows(bpy.types.Operator):
+    """Remove the RT Lit shadows: the probe view layers, the light copies and the compositor they added"""
+
+    bl_idname = "rtl.disable_shadows"
+    bl_label = "Disable RT Lit Shadows"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        from . import shadows
+
+        if not _scene_exists(cls, context):
+            return False
+        if not shadows.shadows_enabled(context.scene):
+            cls.poll_message_set("RT Lit shadows are off in this scene")
+            return False
+        return True
+
+    def execute(self, context):
+        from . import shadows
+
+        shadows.disable_shadows(context.scene, preferences.lut_directory(context))
+        self.report({'INFO'}, "RT Lit shadows off")
+        return {'FINISHED'}
+
+
 class RTL_OT_light_sync_report(bpy.types.Operator):
     """Show why the automatic light sync could not sync the lights (run by it after a failed sync: a depsgraph
     handler cannot report; the RT Lookdev panels keep showing the message until a sync succeeds)"""
@@ -351,4 +415,4 @@ class RTL_OT_bake_luts(ModalTask, bpy.types.Operator):
 
 
 classes = (RTL_OT_lut_status, RTL_OT_bake_luts, RTL_OT_sync_lights, RTL_OT_light_sync_report, RTL_OT_sync_world,
-           RTL_OT_add_node_groups)
+           RTL_OT_add_node_groups, RTL_OT_enable_shadows, RTL_OT_disable_shadows)

@@ -12,8 +12,8 @@ light the ratio is 1 exactly) and, optionally, each denoised with the same filte
 divide").  Here, in one F12 render (``bpy.ops.render.render``), measured by the spike of issue 29 (docs/shadows.md):
 
 - the RT Lit Cycles tree writes each scene light's radiance to a Shader AOV "RTL Light <i>"
-  (``common.light_aov_name``, always emitted: Cycles drops an AOV no view layer declares); the beauty view layer
-  (the user's) declares them;
+  (``common.light_aov_name``, emitted while the scene has shadows on: below); the beauty view layer (the user's)
+  declares them;
 - two probe view layers, "RTL Probe S" and "RTL Probe U", render every object with one material
   (``ViewLayer.material_override``: white diffuse for camera rays, black for the others, so the light-group passes
   hold direct light only); each holds one copy of every scene light, in its own collection: shadowed copies in
@@ -34,18 +34,19 @@ divide").  Here, in one F12 render (``bpy.ops.render.render``), measured by the 
 A scene that already has a compositor is refused (``ShadowError``): this module does not edit a graph it did not
 make.  The AOV nodes are in the RT Lit Cycles trees only while shadows are on (the groups are rebuilt on enable and
 disable): EEVEE compiles an AOV node's inputs whatever the Material Output's target (``materials.AOV_ENGINES``), so
-while shadows are on, render with Cycles.  ``disable_shadows`` removes everything ``enable_shadows`` made; Sync Lights rebuilds the copies
-(``light_sync.sync_lights`` calls ``refresh_shadows``).  Cycles only: EEVEE renders the probe layers but writes no
+while shadows are on, render with Cycles.  ``disable_shadows`` removes everything ``enable_shadows`` made; Sync
+Lights rebuilds the copies (``light_sync.sync_lights`` calls ``refresh_shadows``).  Cycles only: EEVEE renders the probe layers but writes no
 light-group passes (EEVEE's own Shadow pass is the way there, not built yet).
 """
 from __future__ import annotations
 
-import bpy
-
 from pathlib import Path
+
+import bpy
 
 from . import compat, materials, preferences
 from .common import SHADOW_COPY_KEY, SHADOWS_KEY, light_aov_name, node_groups_kept_on_error
+
 #: The probe view layers: (role, view layer name, collection of the light copies, light-group prefix, shadowed).
 PROBES = (("S", "RTL Probe S", "RTL Shadow Lights S", "s_", True),
           ("U", "RTL Probe U", "RTL Shadow Lights U", "u_", False))
@@ -75,6 +76,11 @@ def shadow_settings(scene):
         return None
     stored = stored.to_dict() if hasattr(stored, "to_dict") else dict(stored)
     return {"samples": int(stored["samples"]), "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"])}
+
+
+def shadowed_lights(scene):
+    """Indices of the scene lights whose RT Lit term is shadowed (those synced; none with shadows off)."""
+    return [index for index, _ in _synced_lights(scene)] if shadows_enabled(scene) else []
 
 
 def light_group_name(role, index):
@@ -226,7 +232,7 @@ def _build(scene, beauty, lights, samples, denoise):
             _light_copy(scene, original, collection, light_group_name(role, index), shadowed)
     ours = {c.name for c in collections.values()}
     for layer in scene.view_layers:             # the copies light nothing in the user's layers
-        for child in _layer_collections(layer.layer_collection):
+        for child in _layer_collections(_root_collection(layer)):
             if child.name in ours:
                 child.exclude = True
     layers = {}
@@ -237,7 +243,7 @@ def _build(scene, beauty, lights, samples, denoise):
         layer.material_override = material
         layer.cycles.use_denoising = False
         excluded = _excluded_names(beauty)
-        for child in _layer_collections(layer.layer_collection):
+        for child in _layer_collections(_root_collection(layer)):
             name = child.name
             if name in ours:
                 child.exclude = name != collections[role].name
@@ -250,6 +256,14 @@ def _build(scene, beauty, lights, samples, denoise):
     _build_compositor(scene, beauty, layers, [index for index, _ in lights], denoise)
 
 
+def _root_collection(layer):
+    """The scene collection's layer collection of view ``layer``.  A view layer of a scene made in this session
+    (``bpy.data.scenes.new``) has none until it is synced (``ViewLayer.update``; measured with 4.5 and 5.2)."""
+    if layer.layer_collection is None:
+        layer.update()
+    return layer.layer_collection
+
+
 def _layer_collections(layer_collection):
     """Every layer collection under ``layer_collection`` (depth first; not the scene collection itself)."""
     for child in layer_collection.children:
@@ -258,7 +272,7 @@ def _layer_collections(layer_collection):
 
 
 def _excluded_names(layer):
-    return {child.name for child in _layer_collections(layer.layer_collection) if child.exclude}
+    return {child.name for child in _layer_collections(_root_collection(layer)) if child.exclude}
 
 
 def _only_lights(collection):

@@ -27,6 +27,24 @@ def draw_light_sync_failure(layout, scene):
     row.operator("rtl.sync_lights", icon='FILE_REFRESH')
 
 
+def draw_shadows(layout, scene):
+    """RT Lit's light shadows in ``scene`` (addon/shadows.py): on (its settings, what each engine does) with the
+    button that removes them, or the button that adds them."""
+    from . import shadows
+
+    box = layout.box()
+    settings = shadows.shadow_settings(scene)
+    if settings is None:
+        box.operator("rtl.enable_shadows", icon='LIGHT_SUN')
+        box.label(text="Lights unshadowed in every engine", icon='INFO')
+        return
+    box.label(text=f"Shadows: {settings['samples']} samples{', denoised' if settings['denoise'] else ''}",
+              icon='CHECKMARK')
+    box.label(text="Cycles F12: shadowed (ratio estimator)", icon='BLANK1')
+    box.label(text="EEVEE, viewport: unshadowed", icon='BLANK1')
+    box.operator("rtl.disable_shadows", icon='X')
+
+
 class _PropertiesPanel:
     """An "RT Lookdev" panel of the Properties editor (the context is set by each panel)."""
     bl_label = "RT Lookdev"
@@ -59,6 +77,7 @@ class RTL_PT_material(_PropertiesPanel, bpy.types.Panel):
         else:
             col.operator("rtl.convert_to_rt_lit", icon='SHADING_RENDERED')
         layout.operator("rtl.sync_lights", icon='LIGHT_AREA')
+        draw_shadows(layout, context.scene)
         layout.operator("rtl.sync_world", icon='WORLD')
         layout.operator("rtl.add_node_groups", icon='NODETREE')
         layout.operator("rtl.lut_status", icon='IMAGE_DATA')

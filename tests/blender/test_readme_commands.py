@@ -56,7 +56,7 @@ RUN_BY = {
     "scripts/measure_sheen_table.py": "here",
     "scripts/benchmark_metal_split.py": "here",
     "scripts/benchmark_specular_occlusion.py": "here",
-    "scripts/benchmark_world_occlusion.py": "here",
+    "scripts/benchmark_floor_shadows.py": "here",
 }
 
 #: The commands run here: (script, arguments, files it must write under the output folder).
@@ -80,7 +80,7 @@ SMOKE = {
     "scripts/benchmark_metal_split.py": (["--quick", "--out", "{out}"], ["metal_split.md", "metal_split.json"]),
     "scripts/benchmark_specular_occlusion.py": (["--quick", "--out", "{out}"],
                                                 ["specular_occlusion.md", "specular_occlusion.json"]),
-    "scripts/benchmark_world_occlusion.py": (["--quick", "--out", "{out}"], ["world_occlusion.md", "world_occlusion.json"]),
+    "scripts/benchmark_floor_shadows.py": (["--quick", "--out", "{out}"], ["floor_shadows.md", "floor_shadows.json"]),
 }
 
 

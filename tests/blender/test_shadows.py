@@ -259,3 +259,59 @@ def test_copies_follow_their_light_and_stay_in_their_layer(empty_scene, lut_dir)
     assert seen == {"ViewLayer": {"Key": (*moved, True, "")},           # the originals: in the user's layer only
                     "RTL Probe S": {"Key (s_0)": (*moved, True, "s_0")},
                     "RTL Probe U": {"Key (u_0)": (*moved, False, "u_0")}}
+
+
+def test_enable_on_a_scene_made_in_this_session(empty_scene, lut_dir):
+    """A scene made by ``bpy.data.scenes.new`` (New Lookdev Scene makes one) has view layers without a layer
+    collection until they are synced: enabling shadows there syncs them (it raised AttributeError)."""
+    import bpy
+
+    from rt_lookdev.addon import light_sync, materials, shadows
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    scene = bpy.data.scenes.new("Made Here")
+    scene.render.engine = "CYCLES"
+    light = bpy.data.objects.new("Key", bpy.data.lights.new("Key", "POINT"))
+    light.location = (0.0, 0.0, 2.0)
+    scene.collection.objects.link(light)
+    mesh = bpy.data.meshes.new("Plane")
+    mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+    plane = bpy.data.objects.new("Plane", mesh)
+    scene.collection.objects.link(plane)
+    light_sync.sync_lights(scene, lut_dir)
+    material = bpy.data.materials.new("Plane RT Lit")
+    materials.assign_rt_lit(material, Features(), scene=scene, lut_dir=lut_dir)
+    mesh.materials.append(material)
+    assert scene.view_layers[0].layer_collection is None          # the case: not synced yet
+    shadows.enable_shadows(scene, lut_dir=lut_dir)
+    try:
+        assert shadows.shadows_enabled(scene)
+        assert {name for _, name, *_ in shadows.PROBES} <= set(scene.view_layers.keys())
+    finally:
+        shadows.disable_shadows(scene, lut_dir)
+    assert set(scene.view_layers.keys()) == {"ViewLayer"} and not shadows.shadows_enabled(scene)
+
+
+def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(registered, empty_scene, lut_dir):
+    """Enable / Disable RT Lit Shadows (the RT Lookdev panel's buttons): poll says why not (another engine, shadows
+    already off), enable reports and sets up the probes, the path-traced twin made then lights its copies with the
+    scene's lights only (the probes' light copies render in the probe layers, not in the twin), disable undoes it."""
+    import bpy
+
+    from rt_lookdev.addon import lookdev_scene, shadows
+    from rt_lookdev.addon.common import SHADOW_COPY_KEY
+
+    scene = _scene(bpy, lut_dir, [("Key", "AREA", (0.0, 0.0, 3.0), 200.0, 0.4)])
+    assert not bpy.ops.rtl.disable_shadows.poll()
+    engine = scene.render.engine
+    scene.render.engine = "BLENDER_WORKBENCH"
+    assert not bpy.ops.rtl.enable_shadows.poll()
+    scene.render.engine = engine
+    assert bpy.ops.rtl.enable_shadows(samples=2, denoise=False) == {'FINISHED'}
+    assert shadows.shadow_settings(scene) == {"samples": 2, "denoise": False, "beauty": "ViewLayer"}
+    assert shadows.shadowed_lights(scene) == [0]
+    twin = lookdev_scene.add_path_traced_twin(scene)
+    assert not [o.name for o in twin.objects if SHADOW_COPY_KEY in o]
+    assert [o.name for o in twin.objects if o.type == "LIGHT"] == ["Key"]
+    assert bpy.ops.rtl.disable_shadows() == {'FINISHED'}
+    assert not shadows.shadows_enabled(scene) and not bpy.ops.rtl.disable_shadows.poll()

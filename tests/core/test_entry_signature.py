@@ -29,7 +29,7 @@ CONVERTED = {
     "benchmarks/rt_lit_benchmark": "benchmark_rt_lit.py",
     "benchmarks/specular_occlusion_benchmark": "benchmark_specular_occlusion.py",
     "benchmarks/wrapped_diffuse_benchmark": "benchmark_wrapped_diffuse.py",
-    "benchmarks/world_occlusion_benchmark": "benchmark_world_occlusion.py",
+    "benchmarks/floor_shadows_benchmark": "benchmark_floor_shadows.py",
 }
 
 

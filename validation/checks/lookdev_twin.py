@@ -61,10 +61,11 @@ def _kept_settings(scene):
 
 
 def render_measurement(scene, resolution, samples, seed, folder):
-    """Cycles, measurement settings, transparent film: (RGB (H, W, 3), object index (H, W), seconds)."""
+    """Cycles, measurement settings, transparent film: (RGB (H, W, 3), object index (H, W), seconds).  A scene with
+    RT Lit's light shadows on (addon/shadows.py) renders through its compositor: the RGB is the composited image."""
     import bpy
 
-    from ...addon import compat
+    from ...addon import compat, shadows
     from ..harness.engines import output_settings
 
     exr = Path(folder) / f"{scene.name.replace(' ', '_')}_{seed}.exr"
@@ -72,13 +73,20 @@ def render_measurement(scene, resolution, samples, seed, folder):
         configure_cycles_measurement(scene, samples=samples, seed=seed)   # keeps the scene's bounces
         output_settings(scene, *resolution, exr)
         scene.render.film_transparent = True
-        scene.view_layers[0].use_pass_object_index = True
+        shadowed = shadows.shadows_enabled(scene)
+        scene.render.use_compositing = shadowed
+        beauty = scene.view_layers[shadows.shadow_settings(scene)["beauty"]] if shadowed else scene.view_layers[0]
+        beauty.use_pass_object_index = True
         compat.set_exr_output(scene.render.image_settings, multilayer=True)
         t0 = time.perf_counter()
         bpy.ops.render.render(write_still=True, scene=scene.name)
         seconds = time.perf_counter() - t0
     ch = exr_images.read_channels(exr)
-    rgb = exr_images.find_pass(ch, "Combined", "RGB").astype(np.float64)
+    if shadowed:
+        rgb = np.stack([ch[f"Composite.Combined.{c}"] for c in "RGB"], axis=-1).astype(np.float64)
+        ch = {k: v for k, v in ch.items() if k.startswith(f"{beauty.name}.")}
+    else:
+        rgb = exr_images.find_pass(ch, "Combined", "RGB").astype(np.float64)
     index = np.rint(exr_images.object_index_pass(ch)[..., 0]).astype(int)
     return rgb, index, seconds
 
@@ -267,14 +275,18 @@ def write_pictures(result, folder, prefix="lookdev_"):
 OCCLUSION_SAMPLES = 32
 
 
-def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, features=None, lights=True):
+def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, features=None, lights=True,
+                 light_shadows=None):
     """The lookdev scene with its floor (``new_lookdev_scene(floor=True)``) against its twin: how much of the
     floor the spheres shadow in path tracing, and the error that leaves on it.  ``features``: the RT Lit
     switches of every material (default ``Features()``: nothing occluded); with world occlusion on, the RT Lit
-    render takes ``OCCLUSION_SAMPLES``.  ``lights``: False removes the studio lights (the world alone)."""
+    render takes ``OCCLUSION_SAMPLES``.  ``lights``: False removes the studio lights (the world alone).
+    ``light_shadows``: None, or the options of ``shadows.enable_shadows`` ({"samples": 4, "denoise": True}):
+    the lights' shadows by the ratio estimator, set up after the twin is made.  The result's
+    "floor_darkened" is the floor's error over the pixels path tracing darkens by more than 5%."""
     import bpy
 
-    from ...addon import light_sync, lookdev_scene
+    from ...addon import light_sync, lookdev_scene, shadows
     from ...core.materials.rt_lit_interface import Features
 
     features = features or Features()
@@ -286,6 +298,8 @@ def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, fea
             bpy.data.objects.remove(obj)
         light_sync.sync_lights(scene, lut_dir)
     twin = lookdev_scene.add_path_traced_twin(scene)
+    if light_shadows is not None:
+        shadows.enable_shadows(scene, lut_dir=lut_dir, **light_shadows)
     result = compare(scene, twin, resolution, samples, eevee=False, log=log,
                      rt_lit_samples=1 if features.occlusion == "none" else OCCLUSION_SAMPLES)
     floor = f"{scene.name} Floor"
@@ -299,6 +313,11 @@ def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, fea
     floor_mask = _floor_mask(result, index)
     darkened = (free - shadowed)[floor_mask] / np.maximum(free[floor_mask], 1e-12)
     out["floor_shadowed_fraction"] = float((darkened > 0.05).mean()) if darkened.size else 0.0
+    dark = np.zeros_like(floor_mask)
+    dark[floor_mask] = darkened > 0.05
+    rel, _ = metrics.rel_values(result["images"]["rt_lit"], result["images"]["path_traced"], dark, FLOOR_FRACTION)
+    out["floor_darkened"] = _stats(rel)
+    out["light_shadows"] = light_shadows
     out["floor_mask"] = floor_mask          # (H, W) bool: the floor pixels compared (not JSON: ``run`` drops it)
     log(f"[twin] floor study: {out['floor_shadowed_fraction']:.1%} of the floor darkened > 5% by shadows; floor "
         f"median error {out['floor_with_shadows']['median']:.2%} with, {out['floor_without_shadows']['median']:.2%} "
