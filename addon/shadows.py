@@ -258,7 +258,7 @@ def _build(scene, beauty, lights, samples, denoise):
 
 def _root_collection(layer):
     """The scene collection's layer collection of view ``layer``.  A view layer of a scene made in this session
-    (``bpy.data.scenes.new``) has none until it is synced (``ViewLayer.update``; measured with 4.5 and 5.2)."""
+    (``bpy.data.scenes.new``) has none until it is synced (``ViewLayer.update``; measured with 5.2.3)."""
     if layer.layer_collection is None:
         layer.update()
     return layer.layer_collection

@@ -11,8 +11,9 @@ from rt_lookdev.validation.tools import extension_zip as build_extension
 from _blender_subprocess import run_snippet
 
 #: bpy.ops.rtl.* of the enabled extension
-OPERATORS = ["add_node_groups", "add_path_traced_twin", "bake_luts", "convert_to_principled", "convert_to_rt_lit", "export_luts",
-             "export_scene", "light_sync_report", "lut_status", "new_lookdev_scene", "sync_lights", "sync_world"]
+OPERATORS = ["add_node_groups", "add_path_traced_twin", "bake_luts", "convert_to_principled", "convert_to_rt_lit",
+             "disable_shadows", "enable_shadows", "export_luts", "export_scene", "light_sync_report", "lut_status",
+             "new_lookdev_scene", "sync_lights", "sync_world"]
 
 pytestmark = pytest.mark.blender
 

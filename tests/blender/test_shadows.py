@@ -263,7 +263,7 @@ def test_copies_follow_their_light_and_stay_in_their_layer(empty_scene, lut_dir)
 
 def test_enable_on_a_scene_made_in_this_session(empty_scene, lut_dir):
     """A scene made by ``bpy.data.scenes.new`` (New Lookdev Scene makes one) has view layers without a layer
-    collection until they are synced: enabling shadows there syncs them (it raised AttributeError)."""
+    collection until they are synced (Blender 5.2): enabling shadows there syncs them (it raised AttributeError)."""
     import bpy
 
     from rt_lookdev.addon import light_sync, materials, shadows
@@ -282,7 +282,8 @@ def test_enable_on_a_scene_made_in_this_session(empty_scene, lut_dir):
     material = bpy.data.materials.new("Plane RT Lit")
     materials.assign_rt_lit(material, Features(), scene=scene, lut_dir=lut_dir)
     mesh.materials.append(material)
-    assert scene.view_layers[0].layer_collection is None          # the case: not synced yet
+    if bpy.app.version >= (5, 0):          # the case (5.2.3; 4.5.15 has synced the layer by now)
+        assert scene.view_layers[0].layer_collection is None
     shadows.enable_shadows(scene, lut_dir=lut_dir)
     try:
         assert shadows.shadows_enabled(scene)
