@@ -219,6 +219,16 @@ def test_diffuse_models_equal_core_indirect():
         np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-12, err_msg=diffuse)
 
 
+def _function_values(material, m, normals, views, params):
+    """The material function's inputs: the material values ``m``, the geometry and the world's ``params``."""
+    n = len(normals)
+    inputs = dict(m, Position=np.zeros((n, 3)), **{"Geometry Normal": normals, "Incoming": views})
+    inputs.update({material.world_inputs[k]: (np.broadcast_to(v, (n, 3)) if np.ndim(v) else np.full(n, v))
+                   for k, v in params.items()})
+    inputs["Normal"] = np.zeros((n, 3))
+    return inputs
+
+
 @pytest.mark.parametrize("features", ALL_FEATURES, ids=lambda f: f.label())
 def test_traced_world_equals_numpy(features):
     rng = np.random.default_rng(7)
@@ -231,10 +241,7 @@ def test_traced_world_equals_numpy(features):
     params = _params(coeffs, 1.7, (0.2, -0.4, 1.3))
     want = _radiance(features, env, params, m, normals, views)
     material = rt_lit.build_rt_lit(features, (), env)          # the whole material as the node groups get it
-    inputs = dict(m, Position=np.zeros((n, 3)), **{"Geometry Normal": normals, "Incoming": views})
-    inputs.update({material.world_inputs[k]: (np.broadcast_to(v, (n, 3)) if np.ndim(v) else np.full(n, v))
-                   for k, v in params.items()})
-    inputs["Normal"] = np.zeros((n, 3))
+    inputs = _function_values(material, m, normals, views, params)
     got64 = material.evaluate(inputs, TABLES["luts"], np.float64)["Radiance"]
     np.testing.assert_allclose(got64, want, rtol=2e-6, atol=1e-9)   # as test_ltc_trace (float32 tables)
     got32 = material.evaluate(inputs, TABLES["luts"], np.float32)["Radiance"]
@@ -337,10 +344,7 @@ def test_traced_occluded_world_equals_numpy(features):
     material = rt_lit.build_rt_lit(features, (), env)
     assert material.occlusion_inputs == (OCCLUSION_INPUT,) and OCCLUSION_INPUT in material.internal_inputs
     assert rt_lit.build_rt_lit(features, ("point",), None).occlusion_inputs == ()     # no world: nothing occluded
-    inputs = dict(m, Position=np.zeros((n, 3)), **{"Geometry Normal": normals, "Incoming": views})
-    inputs.update({material.world_inputs[k]: (np.broadcast_to(v, (n, 3)) if np.ndim(v) else np.full(n, v))
-                   for k, v in params.items()})
-    inputs["Normal"] = np.zeros((n, 3))
+    inputs = _function_values(material, m, normals, views, params)
     with pytest.raises(KeyError):
         material.evaluate(inputs, TABLES["luts"], np.float64)
     inputs[OCCLUSION_INPUT] = ao
