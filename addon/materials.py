@@ -290,6 +290,15 @@ ENGINE_TREES = (("Cycles", "CYCLES", "linear", ""), ("EEVEE", "EEVEE", "fetch4",
 #: "Uniform block _node_tree too big (66000/65536)" and a wrong image in tests/blender/test_engine_trees.py).
 AOV_ENGINES = ("Cycles",)
 ENGINE_STAMP_KEY = "rtl_engine_trees"
+#: With the World term's shadows on as well (addon/shadows.py, ``world=True``; a prototype): the Cycles tree writes the
+#: World Radiance part and the world's white-Lambert radiance (SH) to these Shader AOVs (function output -> AOV).
+WORLD_AOVS = {"World Radiance": "RTL World", "World Irradiance": "RTL World Irradiance"}
+
+
+def world_shadows_on(scene):
+    """Whether ``scene``'s RT Lit shadows shadow the World term too (``shadows.enable_shadows(world=True)``)."""
+    stored = scene.get(SHADOWS_KEY)
+    return stored is not None and bool(stored.get("world", False))
 
 
 def engine_tree_name(features, engine):
@@ -326,8 +335,11 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
     tables = _tables(lut_dir, env)
     trees, material_inputs = {}, None
     for engine, _, table_filter_mode, _ in ENGINE_TREES:
+        aovs = engine in AOV_ENGINES and SHADOWS_KEY in scene
+        world_aovs = aovs and env is not None and world_shadows_on(scene)
         with table_filter(table_filter_mode):
-            material = rt_lit.build_rt_lit(features, tuple(records[i][1] for i in shaded), env)
+            material = rt_lit.build_rt_lit(features, tuple(records[i][1] for i in shaded), env,
+                                           world_irradiance=world_aovs)
         inputs = _TreeInputs()
         internal = {n: inputs.geometry(_GEOMETRY_SOCKETS[n]) for n in GEOMETRY_INPUTS}
         # the material function's light k is the scene's light shaded[k]: "Light k p" <- "Light shaded[k] p"; the
@@ -345,9 +357,10 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
                                                  stamp_extra=repr((records, shaded, world_record and world_record["table"],
                                                                    sorted(linked.items()))),
                                                  tables=tables, shader_sums={"Shader": list(material.part_outputs)},
-                                                 aov_outputs=({part: light_aov_name(shaded[k]) for k, part
-                                                               in enumerate(material.part_outputs[1:1 + len(shaded)])}
-                                                              if engine in AOV_ENGINES and SHADOWS_KEY in scene else None))
+                                                 aov_outputs=({**{part: light_aov_name(shaded[k]) for k, part
+                                                                  in enumerate(material.part_outputs[1:1 + len(shaded)])},
+                                                               **(WORLD_AOVS if world_aovs else {})}
+                                                              if aovs else None))
         material_inputs = material.material_inputs
     ng = _ensure_engine_group(name, trees, material_inputs)
     ng[FEATURES_KEY] = features.as_dict()

@@ -56,6 +56,14 @@ PROBE_MATERIAL = "RTL Shadow Probe"
 COMPOSITOR_NAME = "RTL Shadows"
 #: Added to S and U before the division: the ratio is 1 where both are 0.
 EPSILON = 1e-6
+#: The World term's shadows (``world=True``; a prototype, WORLD_RATIO_REPORT.md): the world's light group in probe
+#: layer S, the beauty layer's AOVs of the World Radiance part and of its denominator (the world's white-Lambert
+#: radiance E_SH(N) / pi x Strength: ``materials.WORLD_AOVS``), and the guards of the ratio S_world / E:
+#: (max(S, 0) + eps) / (max(E, 0) + eps), at most WORLD_RATIO_MAX (E is SH, not an estimate from the same samples:
+#: the ratio also carries SH's error, above 1 where SH is too dark).
+WORLD_LIGHT_GROUP = "s_world"
+WORLD_EPSILON = 1e-4
+WORLD_RATIO_MAX = 4.0
 #: Light data properties of the copies driven from the original's (those the light has).
 DRIVEN_PROPERTIES = ("energy", "shadow_soft_size", "size", "size_y", "spot_size", "spot_blend", "angle", "spread")
 
@@ -75,7 +83,8 @@ def shadow_settings(scene):
     if stored is None:
         return None
     stored = stored.to_dict() if hasattr(stored, "to_dict") else dict(stored)
-    return {"samples": int(stored["samples"]), "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"])}
+    return {"samples": int(stored["samples"]), "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"]),
+            "world": bool(stored.get("world", False))}
 
 
 def shadowed_lights(scene):
@@ -89,7 +98,7 @@ def light_group_name(role, index):
     return f"{prefix}{index}"
 
 
-def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None):
+def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None, world=False):
     """Shadow RT Lit materials in ``scene``'s Cycles renders (Heitz et al. 2018's ratio estimator; module docstring).
 
     ``samples``: the probe layers' samples per pixel; ``denoise``: Open Image Denoise on each S and U pass;
@@ -98,11 +107,17 @@ def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None
     groups are rebuilt with the lights' AOVs in their Cycles trees (``materials.AOV_ENGINES``; ``lut_dir``: the
     tables, default the preferences').  Enabling again rebuilds everything (the same result).  Raises ``ShadowError``
     (changing nothing) when the scene renders with another engine, has no synced light, or has a compositor of its
-    own."""
-    _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups=True)
+    own.
+
+    ``world`` (a prototype, WORLD_RATIO_REPORT.md): shadow the World term too, by the ratio S_world / E_SH: the world
+    in light group ``WORLD_LIGHT_GROUP`` lights the white probe of layer S (path traced: shadowed, and the image's
+    irradiance rather than its SH), over the RT Lit world's white-Lambert radiance (an AOV, exact), times the World
+    Radiance part (an AOV): ``final += AOV_world (ratio - 1)``.  Meant with ``Features.occlusion`` "none" (with AO
+    on, the World term would be occluded twice).  No light is needed then."""
+    _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups=True, world=world)
 
 
-def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups):
+def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups, world=False):
     settings = shadow_settings(scene)
     if scene.render.engine != "CYCLES":
         raise ShadowError(f"RT Lit shadows need Cycles (the scene renders with {scene.render.engine})")
@@ -110,16 +125,20 @@ def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups):
     if tree is not None and not tree.get(SHADOWS_KEY):
         raise ShadowError("The scene has a compositor of its own; RT Lit shadows build theirs and do not edit another "
                           "one: remove it (or its nodes) first")
-    lights = _synced_lights(scene)
+    if world and scene.world is None:
+        raise ShadowError("The scene has no world to shadow")
+    lights = _synced_lights(scene, allow_none=world)
     beauty = _beauty_layer(scene, view_layer or (settings["beauty"] if settings is not None else None))
     use_compositing = bool(scene[SHADOWS_KEY]["use_compositing"]) if settings is not None \
         else bool(scene.render.use_compositing)
     if settings is not None:
         _remove_parts(scene)
     scene[SHADOWS_KEY] = {"samples": int(samples), "denoise": bool(denoise), "beauty": beauty.name,
-                          "use_compositing": use_compositing, "aovs": []}
+                          "use_compositing": use_compositing, "aovs": [], "world": bool(world)}
+    if world:
+        scene[SHADOWS_KEY]["world_lightgroup"] = str(scene.world.lightgroup)
     try:
-        _build(scene, beauty, lights, int(samples), bool(denoise))
+        _build(scene, beauty, lights, int(samples), bool(denoise), bool(world))
         if rebuild_groups:              # the AOVs in the RT Lit Cycles trees (kept when they are there)
             _rebuild_groups(scene, lut_dir)
     except BaseException:
@@ -133,7 +152,8 @@ def refresh_shadows(scene, lut_dir=None):
     settings = shadow_settings(scene)
     if settings is None:
         return False
-    _enable(scene, settings["samples"], settings["denoise"], settings["beauty"], lut_dir, rebuild_groups=False)
+    _enable(scene, settings["samples"], settings["denoise"], settings["beauty"], lut_dir, rebuild_groups=False,
+            world=settings["world"])
     return True
 
 
@@ -169,6 +189,8 @@ def _remove_parts(scene):
         del tree[SHADOWS_KEY]
         compat.remove_compositor(scene, tree)
     scene.render.use_compositing = bool(stored.get("use_compositing", True))
+    if "world_lightgroup" in stored and scene.world is not None:
+        scene.world.lightgroup = str(stored["world_lightgroup"])
     beauty = scene.view_layers.get(str(stored.get("beauty", "")))
     if beauty is not None:
         for name in list(stored.get("aovs", [])):
@@ -201,21 +223,22 @@ def _beauty_layer(scene, name):
     return layer
 
 
-def _synced_lights(scene):
+def _synced_lights(scene, allow_none=False):
     """[(scene light index, object)] of the last light sync (the indices of the RT Lit trees' AOVs)."""
     out = []
     for index, (name, _) in enumerate(materials.synced_light_kinds()):
         obj = scene.objects.get(name)
         if obj is not None and obj.type == "LIGHT":
             out.append((index, obj))
-    if not out:
+    if not out and not allow_none:
         raise ShadowError("No light is synced with the RT Lit materials: run Sync Lights first")
     return out
 
 
-def _build(scene, beauty, lights, samples, denoise):
+def _build(scene, beauty, lights, samples, denoise, world=False):
     stored = scene[SHADOWS_KEY]
-    added = [light_aov_name(index) for index, _ in lights if beauty.aovs.get(light_aov_name(index)) is None]
+    names = [light_aov_name(index) for index, _ in lights] + (list(materials.WORLD_AOVS.values()) if world else [])
+    added = [name for name in names if beauty.aovs.get(name) is None]
     for name in added:
         aov = beauty.aovs.add()
         aov.name = name
@@ -251,9 +274,13 @@ def _build(scene, beauty, lights, samples, denoise):
                 child.exclude = True
         for index, _ in lights:
             layer.lightgroups.add(name=light_group_name(role, index))
+        if world and role == "S":
+            layer.lightgroups.add(name=WORLD_LIGHT_GROUP)
+    if world:
+        scene.world.lightgroup = WORLD_LIGHT_GROUP
     scene.render.use_compositing = True
     scene.render.use_single_layer = False
-    _build_compositor(scene, beauty, layers, [index for index, _ in lights], denoise)
+    _build_compositor(scene, beauty, layers, [index for index, _ in lights], denoise, world)
 
 
 def _root_collection(layer):
@@ -344,7 +371,7 @@ def _drive(data, prop, source, path, index=-1):
     var.targets[0].data_path = path
 
 
-def _build_compositor(scene, beauty, layers, indices, denoise):
+def _build_compositor(scene, beauty, layers, indices, denoise, world=False):
     """final = beauty + sum_i AOV_i * (clamp((S_i + eps) / (U_i + eps), 0, 1) - 1), each S_i, U_i denoised when
     ``denoise``; written as beauty - AOV_i + AOV_i * ratio_i, so the result keeps the beauty's alpha."""
     tree, result = compat.new_compositor(scene, COMPOSITOR_NAME)
@@ -366,6 +393,20 @@ def _build_compositor(scene, beauty, layers, indices, denoise):
             parts[role] = compat.mix_colors(tree, socket, (EPSILON,) * 3, "ADD")
         ratio = compat.mix_colors(tree, parts["S"], parts["U"], "DIVIDE", clamp=True)
         aov = render["beauty"].outputs[light_aov_name(index)]
+        image = compat.mix_colors(tree, image, aov, "SUBTRACT")
+        image = compat.mix_colors(tree, image, compat.mix_colors(tree, aov, ratio, "MULTIPLY"), "ADD")
+    if world:       # the World term: AOV_world * (S_world / E_SH - 1), guarded (WORLD_EPSILON, WORLD_RATIO_MAX)
+        socket = render["S"].outputs[f"Combined_{WORLD_LIGHT_GROUP}"]
+        if denoise:
+            socket = compat.new_denoise(tree, socket)
+        s_world = compat.mix_colors(tree, compat.mix_colors(tree, socket, (0.0,) * 3, "LIGHTEN"),
+                                    (WORLD_EPSILON,) * 3, "ADD")
+        irradiance = render["beauty"].outputs[materials.WORLD_AOVS["World Irradiance"]]
+        e_world = compat.mix_colors(tree, compat.mix_colors(tree, irradiance, (0.0,) * 3, "LIGHTEN"),
+                                    (WORLD_EPSILON,) * 3, "ADD")
+        ratio = compat.mix_colors(tree, compat.mix_colors(tree, s_world, e_world, "DIVIDE"),
+                                  (WORLD_RATIO_MAX,) * 3, "DARKEN")
+        aov = render["beauty"].outputs[materials.WORLD_AOVS["World Radiance"]]
         image = compat.mix_colors(tree, image, aov, "SUBTRACT")
         image = compat.mix_colors(tree, image, compat.mix_colors(tree, aov, ratio, "MULTIPLY"), "ADD")
     tree.links.new(image, result)
