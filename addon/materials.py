@@ -386,7 +386,10 @@ def _ensure_engine_group(name, trees, material_inputs):
     ng = bpy.data.node_groups.get(name)
     if ng is None:
         ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
-    stamp = repr([(engine, tree.name) for engine, tree in trees.items()] + list(material_inputs))
+    # a tree's outputs in the stamp: a tree rebuilt with another output list (the World shadows' "World Irradiance")
+    # loses the links of this group's node to it
+    stamp = repr([(engine, tree.name, [i.name for i in tree.interface.items_tree if getattr(i, "in_out", "") == "OUTPUT"])
+                  for engine, tree in trees.items()] + list(material_inputs))
     wanted = [(engine_output(engine, out), "OUTPUT", RT_LIT_OUTPUTS[out].kind, RT_LIT_OUTPUTS[out])
               for engine in trees for out in RT_LIT_OUTPUTS]
     wanted += [(n, "INPUT", RT_LIT_INPUTS[n].kind, RT_LIT_INPUTS[n]) for n in material_inputs]
