@@ -64,6 +64,9 @@ EPSILON = 1e-6
 WORLD_LIGHT_GROUP = "s_world"
 WORLD_EPSILON = 1e-4
 WORLD_RATIO_MAX = 4.0
+#: Experiment only (WORLD_RATIO_REPORT.md): the denominator E_SH is multiplied by this per channel.  The floor study's
+#: "S / E_brute" rows set it to E_brute(up) / E_SH(up) (the floor's normal): the SH bias left in, visibility only.
+WORLD_DENOMINATOR_SCALE = (1.0, 1.0, 1.0)
 #: Light data properties of the copies driven from the original's (those the light has).
 DRIVEN_PROPERTIES = ("energy", "shadow_soft_size", "size", "size_y", "spot_size", "spot_blend", "angle", "spread")
 
@@ -402,6 +405,9 @@ def _build_compositor(scene, beauty, layers, indices, denoise, world=False):
         s_world = compat.mix_colors(tree, compat.mix_colors(tree, socket, (0.0,) * 3, "LIGHTEN"),
                                     (WORLD_EPSILON,) * 3, "ADD")
         irradiance = render["beauty"].outputs[materials.WORLD_AOVS["World Irradiance"]]
+        if tuple(WORLD_DENOMINATOR_SCALE) != (1.0, 1.0, 1.0):
+            irradiance = compat.mix_colors(tree, irradiance, tuple(float(x) for x in WORLD_DENOMINATOR_SCALE),
+                                           "MULTIPLY")
         e_world = compat.mix_colors(tree, compat.mix_colors(tree, irradiance, (0.0,) * 3, "LIGHTEN"),
                                     (WORLD_EPSILON,) * 3, "ADD")
         ratio = compat.mix_colors(tree, compat.mix_colors(tree, s_world, e_world, "DIVIDE"),

@@ -26,12 +26,22 @@ ROWS = {
     "wr16": (True, "none", {"samples": 16, "denoise": True, "world": True}),
     "wr16raw": (True, "none", {"samples": 16, "denoise": False, "world": True}),
     "wr_cc4": (True, "cones_clipped", {"samples": 4, "denoise": True, "world": True}),
+    "wr4_brute": (True, "none", {"samples": 4, "denoise": True, "world": True}),
     "w_none": (False, "none", None),
     "w_cc": (False, "cones_clipped", None),
     "w_wr4": (False, "none", {"samples": 4, "denoise": True, "world": True}),
     "w_wr16": (False, "none", {"samples": 16, "denoise": True, "world": True}),
     "w_wr64raw": (False, "none", {"samples": 64, "denoise": False, "world": True}),
+    "w_wr4_brute": (False, "none", {"samples": 4, "denoise": True, "world": True}),
 }
+
+
+def _brute_scale():
+    """E_brute(up) / E_SH(up) of the studio HDRI (the floor's normal; its world is rotated about z only)."""
+    from rt_lookdev.core.environment import equirect, sh
+    env = equirect.Environment(np.asarray(equirect.read_equirect(equirect.resolve_hdri("studio"))))
+    up = np.array([[0.0, 0.0, 1.0]])
+    return tuple(float(x) for x in (sh.irradiance_brute_force(env, up) / sh.sh_irradiance(sh.sh_project(env), up))[0])
 
 
 def main(argv):
@@ -49,6 +59,8 @@ def main(argv):
     images = {}
     for name in args.rows.split(","):
         lights, occlusion, shadow = ROWS[name]
+        from rt_lookdev.addon import shadows
+        shadows.WORLD_DENOMINATOR_SCALE = _brute_scale() if name.endswith("_brute") else (1.0, 1.0, 1.0)
         t0 = time.perf_counter()
         study = lookdev_twin.shadow_study(None, tuple(args.res), args.samples, print, Features(occlusion=occlusion),
                                           lights=lights, light_shadows=shadow)

@@ -316,3 +316,44 @@ def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(re
     assert [o.name for o in twin.objects if o.type == "LIGHT"] == ["Key"]
     assert bpy.ops.rtl.disable_shadows() == {'FINISHED'}
     assert not shadows.shadows_enabled(scene) and not bpy.ops.rtl.disable_shadows.poll()
+
+
+def test_world_ratio_prototype_shadows_the_world_term_and_disable_restores(empty_scene, lut_dir, tmp_path):
+    """``enable_shadows(world=True)`` (prototype, WORLD_RATIO_REPORT.md) on the floor study lit by the world alone:
+    the beauty still renders (a tree rebuilt with the "World Irradiance" output once unlinked the Cycles Shader of
+    the RT Lit group: a black beauty), the floor gets darker (the spheres' shadows and SH's 24% too bright zenith
+    irradiance), and disable puts the world's light group and the trees back."""
+    import bpy
+
+    from rt_lookdev.addon import light_sync, lookdev_scene, materials, shadows
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+    from rt_lookdev.validation.checks import lookdev_twin
+
+    scene = lookdev_scene.new_lookdev_scene("WR", Features(), view_transform="Standard", lut_dir=lut_dir, floor=True)
+    for obj in [o for o in scene.objects if o.type == "LIGHT"]:
+        bpy.data.objects.remove(obj)
+    light_sync.sync_lights(scene, lut_dir)
+    floor = scene.objects["WR Floor"]
+    for i, obj in enumerate(lookdev_scene.lookdev_spheres(scene), start=1):
+        obj.pass_index = i
+    res = (48, 30)
+    plain, index, _ = lookdev_twin.render_measurement(scene, res, 1, 0, tmp_path)
+    with pytest.raises(shadows.ShadowError):
+        shadows.enable_shadows(scene, lut_dir=lut_dir)            # no light and no world option: nothing to shadow
+    shadows.enable_shadows(scene, samples=4, denoise=False, lut_dir=lut_dir, world=True)
+    assert scene.world.lightgroup == shadows.WORLD_LIGHT_GROUP
+    shaded, index_s, _ = lookdev_twin.render_measurement(scene, res, 1, 0, tmp_path)
+    on_floor = (index == floor.pass_index) & (index_s == floor.pass_index)
+    assert on_floor.sum() > 100
+    assert np.all(np.isfinite(shaded))
+    ratio = shaded[on_floor].mean(-1) / plain[on_floor].mean(-1)
+    print(f"floor ratio p10/p50/p90 {np.percentile(ratio, [10, 50, 90])}")
+    assert 0.4 < np.median(ratio) < 0.95
+    shadows.disable_shadows(scene, lut_dir)
+    assert scene.world.lightgroup == ""
+    for ng in bpy.data.node_groups:
+        if ng.name.endswith("[Cycles]"):
+            assert "World Irradiance" not in [i.name for i in ng.interface.items_tree]
+    again, index_d, _ = lookdev_twin.render_measurement(scene, res, 1, 0, tmp_path)
+    np.testing.assert_allclose(again, plain, rtol=1e-5, atol=1e-6)
+    assert materials.world_shadows_on(scene) is False
