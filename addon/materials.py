@@ -292,7 +292,8 @@ AOV_ENGINES = ("Cycles",)
 ENGINE_STAMP_KEY = "rtl_engine_trees"
 #: With the World term's shadows on as well (addon/shadows.py, ``world=True``; a prototype): the Cycles tree writes the
 #: World Radiance part and the world's white-Lambert radiance (SH) to these Shader AOVs (function output -> AOV).
-WORLD_AOVS = {"World Radiance": "RTL World", "World Irradiance": "RTL World Irradiance"}
+WORLD_AOVS = {"World Radiance": "RTL World", "World Irradiance": "RTL World Irradiance",
+              "World Diffuse": "RTL World Diffuse"}
 
 
 def world_shadows_on(scene):

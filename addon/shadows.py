@@ -87,7 +87,7 @@ def shadow_settings(scene):
         return None
     stored = stored.to_dict() if hasattr(stored, "to_dict") else dict(stored)
     return {"samples": int(stored["samples"]), "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"]),
-            "world": bool(stored.get("world", False))}
+            "world": stored.get("world", False)}
 
 
 def shadowed_lights(scene):
@@ -116,7 +116,8 @@ def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None
     in light group ``WORLD_LIGHT_GROUP`` lights the white probe of layer S (path traced: shadowed, and the image's
     irradiance rather than its SH), over the RT Lit world's white-Lambert radiance (an AOV, exact), times the World
     Radiance part (an AOV): ``final += AOV_world (ratio - 1)``.  Meant with ``Features.occlusion`` "none" (with AO
-    on, the World term would be occluded twice).  No light is needed then."""
+    on, the World term would be occluded twice).  No light is needed then.  ``world="diffuse"``: the ratio on the
+    Lambert diffuse part only (albedo x E_SH / pi x Strength, an AOV), the world's specular left unshadowed."""
     _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups=True, world=world)
 
 
@@ -137,11 +138,11 @@ def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups, world=
     if settings is not None:
         _remove_parts(scene)
     scene[SHADOWS_KEY] = {"samples": int(samples), "denoise": bool(denoise), "beauty": beauty.name,
-                          "use_compositing": use_compositing, "aovs": [], "world": bool(world)}
+                          "use_compositing": use_compositing, "aovs": [], "world": world if world == "diffuse" else bool(world)}
     if world:
         scene[SHADOWS_KEY]["world_lightgroup"] = str(scene.world.lightgroup)
     try:
-        _build(scene, beauty, lights, int(samples), bool(denoise), bool(world))
+        _build(scene, beauty, lights, int(samples), bool(denoise), world if world == "diffuse" else bool(world))
         if rebuild_groups:              # the AOVs in the RT Lit Cycles trees (kept when they are there)
             _rebuild_groups(scene, lut_dir)
     except BaseException:
@@ -412,7 +413,9 @@ def _build_compositor(scene, beauty, layers, indices, denoise, world=False):
                                     (WORLD_EPSILON,) * 3, "ADD")
         ratio = compat.mix_colors(tree, compat.mix_colors(tree, s_world, e_world, "DIVIDE"),
                                   (WORLD_RATIO_MAX,) * 3, "DARKEN")
-        aov = render["beauty"].outputs[materials.WORLD_AOVS["World Radiance"]]
+        # world="diffuse": the ratio on the Lambert diffuse part only (the specular unshadowed)
+        part = "World Diffuse" if world == "diffuse" else "World Radiance"
+        aov = render["beauty"].outputs[materials.WORLD_AOVS[part]]
         image = compat.mix_colors(tree, image, aov, "SUBTRACT")
         image = compat.mix_colors(tree, image, compat.mix_colors(tree, aov, ratio, "MULTIPLY"), "ADD")
     tree.links.new(image, result)

@@ -27,6 +27,8 @@ ROWS = {
     "wr16raw": (True, "none", {"samples": 16, "denoise": False, "world": True}),
     "wr_cc4": (True, "cones_clipped", {"samples": 4, "denoise": True, "world": True}),
     "wr4_brute": (True, "none", {"samples": 4, "denoise": True, "world": True}),
+    "wrd4": (True, "none", {"samples": 4, "denoise": True, "world": "diffuse"}),
+    "w_wrd4": (False, "none", {"samples": 4, "denoise": True, "world": "diffuse"}),
     "w_none": (False, "none", None),
     "w_cc": (False, "cones_clipped", None),
     "w_wr4": (False, "none", {"samples": 4, "denoise": True, "world": True}),
