@@ -309,7 +309,7 @@ def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(re
     assert not bpy.ops.rtl.enable_shadows.poll()
     scene.render.engine = engine
     assert bpy.ops.rtl.enable_shadows(samples=2, denoise=False) == {'FINISHED'}
-    assert shadows.shadow_settings(scene) == {"samples": 2, "denoise": False, "beauty": "ViewLayer"}
+    assert shadows.shadow_settings(scene) == {"samples": 2, "denoise": False, "beauty": "ViewLayer", "world": False}
     assert shadows.shadowed_lights(scene) == [0]
     twin = lookdev_scene.add_path_traced_twin(scene)
     assert not [o.name for o in twin.objects if SHADOW_COPY_KEY in o]
