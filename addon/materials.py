@@ -15,6 +15,8 @@
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import bpy
 import numpy as np
 
@@ -290,10 +292,10 @@ ENGINE_TREES = (("Cycles", "CYCLES", "linear", ""), ("EEVEE", "EEVEE", "fetch4",
 #: "Uniform block _node_tree too big (66000/65536)" and a wrong image in tests/blender/test_engine_trees.py).
 AOV_ENGINES = ("Cycles",)
 ENGINE_STAMP_KEY = "rtl_engine_trees"
-#: With the World term's shadows on as well (addon/shadows.py, ``world=True``; a prototype): the Cycles tree writes the
-#: World Radiance part and the world's white-Lambert radiance (SH) to these Shader AOVs (function output -> AOV).
-WORLD_AOVS = {"World Radiance": "RTL World", "World Irradiance": "RTL World Irradiance",
-              "World Diffuse": "RTL World Diffuse"}
+#: With the World term's shadows on as well (addon/shadows.py, ``world=True``): the Cycles tree writes the World
+#: Radiance part and the world's white-Lambert radiance (SH) to these Shader AOVs (function output -> AOV), and leaves
+#: out ``Features.occlusion`` (the ratio occludes the world there).
+WORLD_AOVS = {"World Radiance": "RTL World", "World Irradiance": "RTL World Irradiance"}
 
 
 def world_shadows_on(scene):
@@ -339,8 +341,8 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
         aovs = engine in AOV_ENGINES and SHADOWS_KEY in scene
         world_aovs = aovs and env is not None and world_shadows_on(scene)
         with table_filter(table_filter_mode):
-            material = rt_lit.build_rt_lit(features, tuple(records[i][1] for i in shaded), env,
-                                           world_irradiance=world_aovs)
+            material = rt_lit.build_rt_lit(replace(features, occlusion="none") if world_aovs else features,
+                                           tuple(records[i][1] for i in shaded), env, world_irradiance=world_aovs)
         inputs = _TreeInputs()
         internal = {n: inputs.geometry(_GEOMETRY_SOCKETS[n]) for n in GEOMETRY_INPUTS}
         # the material function's light k is the scene's light shaded[k]: "Light k p" <- "Light shaded[k] p"; the

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import lights, shading_ops as op
+from .. import lights
 from ..ir.expr import FLOAT, VECTOR, define, folding, folding_enabled, table_filter_mode
 from ..ir.functions import NodeFunction
 from ..ir.interface import color
@@ -48,7 +48,6 @@ from .surface import SURFACE
 #: world's white-Lambert radiance E_SH(N) / pi x Strength, the denominator of the World term's ratio estimator
 #: (addon/shadows.py, ``world=True``).
 WORLD_IRRADIANCE_OUTPUT = "World Irradiance"
-WORLD_DIFFUSE_OUTPUT = "World Diffuse"
 
 
 def light_parameters(kind):
@@ -76,8 +75,6 @@ def compose(tables, features, material, geometry, lights_in_scene, world=None, e
         parts.append(world_shading.shade_world(tables, features, env, surface, params, geometry.get(OCCLUSION_INPUT)))
         if extras is not None:
             extras[WORLD_IRRADIANCE_OUTPUT] = world_shading.world_irradiance(surface, params)
-            # the Lambert diffuse part alone (exact for Features.diffuse "lambert", unoccluded): the "diffuse only" variant
-            extras[WORLD_DIFFUSE_OUTPUT] = op.vmul(surface["Albedo"], extras[WORLD_IRRADIANCE_OUTPUT])
     return parts
 
 
@@ -276,7 +273,6 @@ def _build(features, light_kinds, environment, folded, table_filter, world_irrad
     out_sockets.update({n: color((0.0, 0.0, 0.0), f"{n} towards the viewer") for n in part_names})
     if world_irradiance:
         out_sockets[WORLD_IRRADIANCE_OUTPUT] = color((0.0, 0.0, 0.0), "The world's white-Lambert radiance (SH)")
-        out_sockets[WORLD_DIFFUSE_OUTPUT] = color((0.0, 0.0, 0.0), "Albedo x the world's white-Lambert radiance")
     env_label = f"; {environment.name}" if environment is not None else ""
     name = f"RT Lit ({features.label()}; {len(light_kinds)} lights{env_label}{'; irradiance' if world_irradiance else ''})"
     function = define(name, body, kinds, f"RT Lit lookdev material ({features.label()})", (sockets, out_sockets))

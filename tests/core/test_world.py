@@ -360,3 +360,32 @@ def test_occlusion_switch_validates_and_names_the_group():
         Features(occlusion="ssao")
     assert Features(occlusion="cones_clipped").label() == "turquin, cod, cones-clipped AO"
     assert Features.from_dict({"specular": "single"}).occlusion == "none"      # materials stored before the switch
+
+
+@pytest.mark.parametrize("rotation", [(0.0, 0.0, 0.0), (0.2, -0.4, 1.3)])
+def test_world_irradiance_output_is_the_sh_cosine_lobe_about_the_rotated_normal(rotation):
+    """The World shadows' denominator (``build_rt_lit(world_irradiance=True)``, addon/shadows.py): E_SH(N) / pi x
+    Strength (Ramamoorthi & Hanrahan 2001's cosine lobe, the world's rotation applied to the normal as its diffuse
+    does), in float64 and float32; the radiance is the same as without the extra output."""
+    rng = np.random.default_rng(11)
+    env = _random_env(rng)
+    coeffs = rng.normal(size=(9, 3))
+    coeffs[0] += 4.0
+    normals, views = _geometry(rng, 200)
+    m = _material(rng, len(normals))
+    params = _params(coeffs, 1.7, rotation)
+    rows = [np.asarray(r, np.float64) for r in world.euler_xyz_rows(np.asarray(rotation, np.float64))]
+    rotated = np.stack([normals @ r for r in rows], -1)
+    want = 1.7 * indirect.sh_cosine_lobe_eval(coeffs, rotated)
+    material = rt_lit.build_rt_lit(Features(), (), env, world_irradiance=True)
+    inputs = _function_values(material, m, normals, views, params)
+    both = ("Radiance", rt_lit.WORLD_IRRADIANCE_OUTPUT)
+    out = material.evaluate(inputs, TABLES["luts"], np.float64, outputs=both)
+    # rtol 1e-6: at the grazing views of _geometry's edge cases the shading normal (core/materials/surface.py) is
+    # the geometric one moved by its guard, by ~1e-7
+    np.testing.assert_allclose(out[rt_lit.WORLD_IRRADIANCE_OUTPUT], want, rtol=1e-6, atol=1e-12)
+    plain = rt_lit.build_rt_lit(Features(), (), env)
+    np.testing.assert_array_equal(out["Radiance"], plain.evaluate(inputs, TABLES["luts"], np.float64)["Radiance"])
+    out32 = material.evaluate(inputs, TABLES["luts"], np.float32, outputs=both)[rt_lit.WORLD_IRRADIANCE_OUTPUT]
+    assert out32.dtype == np.float32
+    np.testing.assert_allclose(out32, want, rtol=1e-5, atol=1e-5)
