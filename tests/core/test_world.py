@@ -243,7 +243,6 @@ def _function_values(material, m, normals, views, params):
 @pytest.mark.parametrize("features", ALL_FEATURES, ids=lambda f: f.label())
 def test_traced_world_equals_numpy(features):
     rng, env, coeffs, normals, views, m = _random_case(7, 300)
-    n = len(normals)
     params = _params(coeffs, 1.7, (0.2, -0.4, 1.3))
     want = _radiance(features, env, params, m, normals, views)
     material = rt_lit.build_rt_lit(features, (), env)          # the whole material as the node groups get it
