@@ -299,7 +299,7 @@ def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(re
     scene's lights only (the probes' light copies render in the probe layers, not in the twin), disable undoes it."""
     import bpy
 
-    from rt_lookdev.addon import lookdev_scene, shadows
+    from rt_lookdev.addon import compat, lookdev_scene, shadows
     from rt_lookdev.addon.common import SHADOW_COPY_KEY
 
     scene = _scene(bpy, lut_dir, [("Key", "AREA", (0.0, 0.0, 3.0), 200.0, 0.4)])
@@ -309,13 +309,22 @@ def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(re
     assert not bpy.ops.rtl.enable_shadows.poll()
     scene.render.engine = engine
     assert bpy.ops.rtl.enable_shadows(samples=2, denoise=False) == {'FINISHED'}
-    assert shadows.shadow_settings(scene) == {"samples": 2, "denoise": False, "beauty": "ViewLayer", "world": False}
+    assert shadows.shadow_settings(scene) == {"engine": "Cycles", "samples": 2, "denoise": False, "beauty": "ViewLayer",
+                                              "world": False}
     assert shadows.shadowed_lights(scene) == [0]
     twin = lookdev_scene.add_path_traced_twin(scene)
     assert not [o.name for o in twin.objects if SHADOW_COPY_KEY in o]
     assert [o.name for o in twin.objects if o.type == "LIGHT"] == ["Key"]
     assert bpy.ops.rtl.disable_shadows() == {'FINISHED'}
     assert not shadows.shadows_enabled(scene) and not bpy.ops.rtl.disable_shadows.poll()
+    scene.render.engine = compat.eevee_engine()             # EEVEE: its Shadow pass, no light copies, no world option
+    assert bpy.ops.rtl.enable_shadows.poll()
+    assert bpy.ops.rtl.enable_shadows(world=True) == {'FINISHED'}
+    assert shadows.shadow_settings(scene) == {"engine": "EEVEE", "samples": 0, "denoise": False, "beauty": "ViewLayer",
+                                              "world": False}
+    assert not [o.name for o in scene.objects if SHADOW_COPY_KEY in o]
+    assert bpy.ops.rtl.disable_shadows() == {'FINISHED'}
+    assert not shadows.shadows_enabled(scene)
 
 
 def test_world_shadows_darken_the_floor_and_disable_restores(empty_scene, lut_dir, tmp_path):
