@@ -46,10 +46,26 @@ backend keep the SH and ``Features.occlusion``.  Measured in docs/shadows.md (th
 
 A scene that already has a compositor is refused (``ShadowError``): this module does not edit a graph it did not
 make.  The AOV nodes are in the RT Lit Cycles trees only while shadows are on (the groups are rebuilt on enable and
-disable): EEVEE compiles an AOV node's inputs whatever the Material Output's target (``materials.AOV_ENGINES``), so
-while shadows are on, render with Cycles.  ``disable_shadows`` removes everything ``enable_shadows`` made; Sync
-Lights rebuilds the copies (``light_sync.sync_lights`` calls ``refresh_shadows``).  Cycles only: EEVEE renders the probe layers but writes no
-light-group passes (EEVEE's own Shadow pass is the way there, not built yet).
+disable): EEVEE compiles an AOV node's inputs whatever the Material Output's target (materials.py, before
+``shadow_engine``), so while Cycles shadows are on, render with Cycles.  ``disable_shadows`` removes everything
+``enable_shadows`` made; Sync Lights rebuilds the copies (``light_sync.sync_lights`` calls ``refresh_shadows``).
+
+EEVEE (``enable_shadows`` on a scene that renders with EEVEE; ``shadow_settings(scene)["engine"]`` = "EEVEE"): EEVEE
+draws no light-group passes, but its Shadow pass (``ViewLayer.use_pass_shadow``) is, per pixel, EEVEE's shadowed
+over its unshadowed diffuse light, all lights summed (measured by the spike of issue 29: docs/shadows.md).  So:
+
+- the RT Lit EEVEE trees write the sum of the lights' radiance to the Shader AOV "RTL Lights"
+  (``common.LIGHTS_AOV``), declared on the beauty layer; the Cycles trees then carry no AOV;
+- one probe view layer ``EEVEE_PROBE`` (the beauty layer's collections, the scene's own lights: no copies) renders
+  every object white diffuse and writes the Shadow pass: by ``material_override`` in 5.x, and on 4.5, where EEVEE
+  ignores the override in renders and gives a Shadow pass of 0 on an emission-only (or black) surface, by the RT Lit
+  EEVEE trees' switch to a white Diffuse BSDF on the view layer property ``common.PROBE_LAYER_ATTRIBUTE`` (1 there);
+- the compositor: ``final = beauty + AOV_lights * (clamp(Shadow, 0, 1) - 1)``.
+
+One ratio scales all lights together (where one light is blocked and another is not, the sum is off: the Cycles
+path's per-light ratio is exact there), and the World term is not shadowed by it (``world`` is a Cycles option; in
+EEVEE it keeps ``Features.occlusion``).  Soft shadows are EEVEE's (its shadow-map filtering, or the lights'
+``use_shadow_jitter`` with enough samples: not set here, they are the user's lights).
 """
 from __future__ import annotations
 
@@ -131,7 +147,8 @@ def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None
     The lights are those of the last light sync (``materials.synced_light_kinds``, the AOVs' indices).  ``world``:
     shadow the World term too (when the scene has a world and RT Lit a World term; its part of the module docstring): the Cycles trees then
     leave out ``Features.occlusion`` (the ratio is the world's occlusion there).  The RT Lit groups are rebuilt with
-    the AOVs in their Cycles trees (``materials.AOV_ENGINES``; ``lut_dir``: the tables, default the preferences').
+    the AOVs in the trees of the shadows' engine (``materials.shadow_engine``; ``lut_dir``: the tables, default the
+    preferences').
     Enabling again rebuilds everything (the same result).  Raises ``ShadowError`` (changing nothing) when the scene
     renders with another engine (or EEVEE with its shadows off), has nothing to shadow (no synced light, and no world
     or ``world`` False), or has a compositor of its own."""
