@@ -56,8 +56,8 @@ over its unshadowed diffuse light, all lights summed (measured by the spike of i
 
 - the RT Lit EEVEE trees write the sum of the lights' radiance to the Shader AOV "RTL Lights"
   (``common.LIGHTS_AOV``), declared on the beauty layer; the Cycles trees then carry no AOV;
-- one probe view layer ``EEVEE_PROBE`` (the beauty layer's collections, the scene's own lights: no copies) renders
-  every object white diffuse and writes the Shadow pass: by ``material_override`` in 5.x, and on 4.5, where EEVEE
+- one probe view layer ``EEVEE_PROBE`` (the beauty layer's collections, the scene's own lights: no copies, a black
+  world: ``PROBE_WORLD``) renders every object white diffuse and writes the Shadow pass: by ``material_override`` in 5.x, and on 4.5, where EEVEE
   ignores the override in renders and gives a Shadow pass of 0 on an emission-only (or black) surface, by the RT Lit
   EEVEE trees' switch to a white Diffuse BSDF on the view layer property ``common.PROBE_LAYER_ATTRIBUTE`` (1 there);
 - the compositor: ``final = beauty + AOV_lights * (clamp(Shadow, 0, 1) - 1)``.
@@ -81,6 +81,11 @@ PROBES = (("S", "RTL Probe S", "RTL Shadow Lights S", "s_", True),
           ("U", "RTL Probe U", "RTL Shadow Lights U", "u_", False))
 #: EEVEE's probe view layer (EEVEE shadows: the scene's own lights, no copies; its Shadow pass).
 EEVEE_PROBE = "RTL Probe Shadow"
+#: EEVEE's probe layer's world (``ViewLayer.world_override``): black.  EEVEE (4.2 on) extracts a shadow-casting sun
+#: from a bright world, which took part in the Shadow pass (the floor study: |Shadow - Cycles' sum S / sum U| median
+#: 0.12 with the scene's world in the probe, 0.06 with a black one; docs/shadows.md); RT Lit's World term is not
+#: shadowed by the pass, so the probe sees the lights alone.
+PROBE_WORLD = "RTL Shadow Probe World"
 #: The material every object has in the probe layers (``ViewLayer.material_override``).
 PROBE_MATERIAL = "RTL Shadow Probe"
 #: The compositor's node group (Blender 5) or the marker name of its nodes (4.5).
@@ -214,9 +219,12 @@ def disable_shadows(scene, lut_dir=None):
         return
     _remove_parts(scene)
     del scene[SHADOWS_KEY]
-    material = bpy.data.materials.get(PROBE_MATERIAL)
-    if material is not None and not any(shadows_enabled(other) for other in bpy.data.scenes):
-        bpy.data.materials.remove(material)
+    if not any(shadows_enabled(other) for other in bpy.data.scenes):
+        material, world = bpy.data.materials.get(PROBE_MATERIAL), bpy.data.worlds.get(PROBE_WORLD)
+        if material is not None:
+            bpy.data.materials.remove(material)
+        if world is not None:
+            bpy.data.worlds.remove(world)
     _rebuild_groups(scene, lut_dir)
 
 
@@ -352,6 +360,7 @@ def _build_eevee(scene, beauty):
     layer = scene.view_layers.new(EEVEE_PROBE)
     layer.material_override = _probe_material()    # 5.x; on 4.5 the RT Lit EEVEE trees switch by the property
     layer[PROBE_LAYER_ATTRIBUTE] = 1.0
+    layer.world_override = _probe_world()
     layer.use_pass_shadow = True
     for child in _layer_collections(_root_collection(layer)):
         if child.name in excluded:
@@ -426,6 +435,17 @@ def _probe_material():
     links.new(mix.outputs[0], output.inputs["Surface"])
     path.location, diffuse.location, mix.location = (-400.0, 200.0), (-400.0, -100.0), (-150.0, 0.0)
     return material
+
+
+def _probe_world():
+    """A black world (colour 0; its Background nodes at strength 0): EEVEE's probe layer's ``world_override``."""
+    world = bpy.data.worlds.get(PROBE_WORLD) or compat.new_world(PROBE_WORLD)
+    world.color = (0.0, 0.0, 0.0)
+    for node in world.node_tree.nodes if world.node_tree is not None else ():
+        if node.bl_idname == "ShaderNodeBackground":
+            node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+            node.inputs["Strength"].default_value = 0.0
+    return world
 
 
 def _light_copy(scene, original, collection, group, shadowed):

@@ -181,6 +181,7 @@ def _state(bpy, scene):
                          for vl in scene.view_layers},
             "objects": names(bpy.data.objects), "lights": names(bpy.data.lights),
             "collections": names(bpy.data.collections), "materials": names(bpy.data.materials),
+            "worlds": names(bpy.data.worlds),
             "node groups": names(bpy.data.node_groups), "compositor": compat.compositor_tree(scene) is not None,
             "aov nodes": sorted(n.aov_name for ng in bpy.data.node_groups if ng.bl_idname == "ShaderNodeTree"
                                 for n in ng.nodes if n.bl_idname == "ShaderNodeOutputAOV"),
@@ -470,6 +471,7 @@ def test_eevee_disable_restores_and_reload_keeps_it(empty_scene, lut_dir, tmp_pa
     once = _state(bpy, scene)
     assert set(once["view layers"]) - set(before["view layers"]) == {shadows.EEVEE_PROBE}
     assert once["objects"] == before["objects"] and once["compositor"]
+    assert scene.view_layers[shadows.EEVEE_PROBE].world_override.name == shadows.PROBE_WORLD   # no world sun there
     assert once["aovs"]["ViewLayer"] == ["RTL Lights"] and once["aov nodes"] == ["RTL Lights"]
     assert all(ng.name.endswith("[EEVEE]") for ng in bpy.data.node_groups
                if any(n.bl_idname == "ShaderNodeOutputAOV" for n in ng.nodes))
