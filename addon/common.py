@@ -53,6 +53,16 @@ SAVED_EMISSION_SAMPLING_KEY = "rtl_saved_emission_sampling"
 #: Shader AOV of the RT Lit Cycles tree holding scene light i's unshadowed radiance: "RTL Light <i>"
 #: (``light_aov_name``; read by the shadow compositor, addon/shadows.py).
 LIGHT_AOV_PREFIX = "RTL Light "
+#: Shader AOV of the RT Lit EEVEE tree holding the sum of the scene lights' unshadowed radiance, written while the
+#: scene has EEVEE shadows on (addon/shadows.py: EEVEE's Shadow pass is one ratio for all lights together).
+LIGHTS_AOV = "RTL Lights"
+#: The engines RT Lit shadows are built for (``shadows.shadow_settings(scene)["engine"]``): the RT Lit tree of that
+#: engine (addon/materials.ENGINE_TREES) writes the AOVs.
+SHADOW_ENGINES = ("Cycles", "EEVEE")
+#: The view layer property (1.0 in EEVEE shadows' probe layer) by which the RT Lit EEVEE tree, while the scene has
+#: EEVEE shadows on, shades white diffuse instead of its emission: EEVEE 4.5 ignores ``ViewLayer.material_override``
+#: in renders (measured with 4.5.15; 5.2.3 applies it) and its Shadow pass needs a lit closure.
+PROBE_LAYER_ATTRIBUTE = "rtl_shadow_probe"
 #: Custom property of a scene with RT Lit shadows on (addon/shadows.py: its settings); its RT Lit Cycles trees then
 #: write the lights' AOVs (``materials.ensure_rt_lit_group``).
 SHADOWS_KEY = "rtl_shadows"
@@ -63,7 +73,8 @@ SHADOW_COPY_KEY = "rtl_shadow_copy"
 __all__ = ["NODE_GROUP_PREFIX", "RT_LIT_GROUP_PREFIX", "SCENE_LIGHTS_GROUP", "WORLD_GROUP", "FEATURES_KEY",
            "WORLD_RECORD_KEY", "LIGHTS_RECORD_KEY", "LINKING_KEY", "LIGHTS_SIGNATURE_KEY", "LIGHTS_SUBSET_KEY", "REACH_KEY",
            "STAMP_KEY", "RT_LIT_NODE_NAME", "IMAGE_PREFIX", "SOCKET_TYPES",
-           "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "LIGHT_AOV_PREFIX", "SHADOWS_KEY",
+           "ENGINE_SHADER_OUTPUTS", "SAVED_TARGET_KEY", "ADDED_OUTPUT_KEY", "LIGHT_AOV_PREFIX", "LIGHTS_AOV", "SHADOW_ENGINES", "PROBE_LAYER_ATTRIBUTE",
+           "SHADOWS_KEY",
            "SHADOW_COPY_KEY", "light_aov_name", "connect_engine_outputs",
            "restore_engine_outputs", "not_a_light", "restore_emission_sampling",
            "socket_by_identifier", "ensure_interface", "remove_drivers", "add_driver", "add_expression_driver",

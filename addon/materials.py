@@ -28,10 +28,10 @@ from ..core.materials import rt_lit
 from ..core.materials.rt_lit_interface import (GEOMETRY_INPUTS, RT_LIT_INPUTS, RT_LIT_OUTPUTS,
                                                Features, light_input, rt_lit_group_name)
 from . import compat, light_controls, light_model, node_emit, world_sync
-from .common import (FEATURES_KEY, LIGHTS_RECORD_KEY, LINKING_KEY, LIGHTS_SIGNATURE_KEY, LIGHTS_SUBSET_KEY, REACH_KEY,
-                     RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP, SHADOWS_KEY, SHADOW_COPY_KEY, STAMP_KEY,
-                     WORLD_GROUP, connect_engine_outputs, ensure_interface, light_aov_name, not_a_light, remove_drivers,
-                     replace_group, socket_by_identifier)
+from .common import (FEATURES_KEY, LIGHTS_AOV, LIGHTS_RECORD_KEY, LINKING_KEY, LIGHTS_SIGNATURE_KEY, LIGHTS_SUBSET_KEY,
+                     PROBE_LAYER_ATTRIBUTE, REACH_KEY, RT_LIT_GROUP_PREFIX, RT_LIT_NODE_NAME, SCENE_LIGHTS_GROUP,
+                     SHADOWS_KEY, SHADOW_COPY_KEY, STAMP_KEY, WORLD_GROUP, connect_engine_outputs, ensure_interface,
+                     light_aov_name, not_a_light, remove_drivers, replace_group, socket_by_identifier)
 from .light_model import light_kind
 
 #: Geometry node output feeding each geometry input of the material function.
@@ -285,17 +285,24 @@ class _TreeInputs:
 #: lookup); EEVEE's picks mipmaps from screen-space derivatives, so its tree writes the filter out as
 #: four Closest fetches (core.ir.tables.bilinear_function).  docs/blender.md, "Per-engine trees".
 ENGINE_TREES = (("Cycles", "CYCLES", "linear", ""), ("EEVEE", "EEVEE", "fetch4", "EEVEE "))
-#: The engine trees that write each light's radiance to a Shader AOV (``common.light_aov_name``) for the shadow
-#: compositor (addon/shadows.py), only while the scene has shadows on (``SHADOWS_KEY``).  Not always: Cycles drops an
-#: AOV node whose AOV no view layer declares, but EEVEE compiles every AOV node's inputs, whatever the Material
-#: Output's target, so the Cycles tree's AOVs put the whole Cycles tree into EEVEE's shader (measured with 5.2.3:
-#: "Uniform block _node_tree too big (66000/65536)" and a wrong image in tests/blender/test_engine_trees.py).
-AOV_ENGINES = ("Cycles",)
+#: While a scene has shadows on (addon/shadows.py), the RT Lit tree of the shadows' engine (``shadow_engine``) writes
+#: the lights' radiance to Shader AOVs for the shadow compositor: the Cycles tree one per light
+#: (``common.light_aov_name``), the EEVEE tree their sum (``common.LIGHTS_AOV``).  Only that engine's tree, and only
+#: while shadows are on: Cycles drops an AOV node whose AOV no view layer declares, but EEVEE compiles every AOV
+#: node's inputs, whatever the Material Output's target, so AOVs in the Cycles tree put the whole Cycles tree into
+#: EEVEE's shader (measured with 5.2.3: "Uniform block _node_tree too big (66000/65536)" and a wrong image in
+#: tests/blender/test_engine_trees.py).
 ENGINE_STAMP_KEY = "rtl_engine_trees"
 #: With the World term's shadows on as well (addon/shadows.py, ``world=True``): the Cycles tree writes the World
 #: Radiance part and the world's white-Lambert radiance (SH) to these Shader AOVs (function output -> AOV), and leaves
 #: out ``Features.occlusion`` (the ratio occludes the world there).
 WORLD_AOVS = {"World Radiance": "RTL World", "World Irradiance": "RTL World Irradiance"}
+
+
+def shadow_engine(scene):
+    """The engine ("Cycles", "EEVEE") whose RT Lit tree writes the shadow AOVs of ``scene``, None with shadows off."""
+    stored = scene.get(SHADOWS_KEY)
+    return None if stored is None else str(stored.get("engine", "Cycles"))
 
 
 def world_shadows_on(scene):
@@ -324,7 +331,7 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
     inputs as its interface, one nested tree per engine (``ENGINE_TREES``) fed by them, and each tree's
     outputs ("Shader", "Radiance" for Cycles; "EEVEE Shader", "EEVEE Radiance").  ``lights``: the indices
     of the scene's lights it shades (``cull_lights``), default all of them.  While ``scene`` has shadows on
-    (addon/shadows.py) the Cycles tree also writes each light's radiance to its AOV (``AOV_ENGINES``)."""
+    (addon/shadows.py) the tree of the shadows' engine also writes the lights' radiance to AOVs (``_aov_outputs``)."""
     features = features or Features()
     scene = scene or bpy.context.scene
     if bpy.data.node_groups.get(SCENE_LIGHTS_GROUP) is None:
@@ -338,7 +345,7 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
     tables = _tables(lut_dir, env)
     trees, material_inputs = {}, None
     for engine, _, table_filter_mode, _ in ENGINE_TREES:
-        aovs = engine in AOV_ENGINES and SHADOWS_KEY in scene
+        aovs = engine == shadow_engine(scene)
         world_aovs = aovs and env is not None and world_shadows_on(scene)
         with table_filter(table_filter_mode):
             material = rt_lit.build_rt_lit(replace(features, occlusion="none") if world_aovs else features,
@@ -360,16 +367,25 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
                                                  stamp_extra=repr((records, shaded, world_record and world_record["table"],
                                                                    sorted(linked.items()))),
                                                  tables=tables, shader_sums={"Shader": list(material.part_outputs)},
-                                                 aov_outputs=({**{part: light_aov_name(shaded[k]) for k, part
-                                                                  in enumerate(material.part_outputs[1:1 + len(shaded)])},
-                                                               **(WORLD_AOVS if world_aovs else {})}
-                                                              if aovs else None))
+                                                 aov_outputs=_aov_outputs(engine, material, shaded, world_aovs)
+                                                 if aovs else None,
+                                                 probe_attribute=PROBE_LAYER_ATTRIBUTE if aovs and engine == "EEVEE"
+                                                 else None)
         material_inputs = material.material_inputs
     ng = _ensure_engine_group(name, trees, material_inputs)
     ng[FEATURES_KEY] = features.as_dict()
     if lights is not None:
         ng[LIGHTS_SUBSET_KEY] = list(shaded)
     return ng
+
+
+def _aov_outputs(engine, material, shaded, world_aovs):
+    """{output name(s): AOV name} of ``engine``'s tree with shadows on: Cycles, each light part to its AOV (and the
+    World AOVs with ``world_aovs``); EEVEE, the sum of the light parts to ``LIGHTS_AOV``."""
+    parts = material.part_outputs[1:1 + len(shaded)]
+    if engine == "EEVEE":
+        return {tuple(parts): LIGHTS_AOV} if parts else {}
+    return {**{part: light_aov_name(shaded[k]) for k, part in enumerate(parts)}, **(WORLD_AOVS if world_aovs else {})}
 
 
 def engine_node_counts(ng):

@@ -292,7 +292,7 @@ class _Emitter:
 
     # -- one tree ----------------------------------------------------------------------------
     def fill(self, ng, outputs, input_names, sockets=None, kinds=None, internal_inputs=None, description="",
-             shader_sums=None, aov_outputs=None):
+             shader_sums=None, aov_outputs=None, probe_attribute=None):
         """Emit ``outputs`` (name -> Expr of one graph) into the empty tree ``ng``.
 
         ``input_names``: interface inputs, in order; ``sockets``: (inputs, outputs), each
@@ -300,9 +300,11 @@ class _Emitter:
         an output socket inside the tree (e.g. Geometry > Position) instead of an interface input.
         ``shader_sums``: shader output name -> names of colour outputs; each becomes an Emission
         closure (strength 1) and they are summed with Add Shader nodes; those colour outputs are
-        not interface sockets.  ``aov_outputs``: colour output name -> Shader AOV name; each such output
-        also feeds a Shader AOV node (Cycles writes it where the view layer declares the AOV, and drops the
-        node where none does: addon/shadows.py reads each light's radiance this way).
+        not interface sockets.  ``aov_outputs``: colour output name (or a tuple of them, summed) -> Shader AOV
+        name; each such output also feeds a Shader AOV node (Cycles writes it where the view layer declares the
+        AOV, and drops the node where none does: addon/shadows.py reads each light's radiance this way).
+        ``probe_attribute``: a view layer attribute; each shader output becomes Mix Shader(its sum, a white Diffuse
+        BSDF) by it (EEVEE shadows' probe layer, addon/shadows.py).
         """
         in_sockets, out_sockets = sockets or ({}, {})
         kinds, internal_inputs, shader_sums = kinds or {}, internal_inputs or {}, shader_sums or {}
@@ -338,25 +340,36 @@ class _Emitter:
         for node in order:
             if node.op not in LEAVES:
                 writer.write(node)
-        self._write_outputs(ng, writer, outs, items, shader_sums, hidden)
+        self._write_outputs(ng, writer, outs, items, shader_sums, hidden, probe_attribute)
         self._write_aovs(ng, writer, dict(outs), aov_outputs or {})
         return ng
 
     @staticmethod
     def _write_aovs(ng, writer, outputs, aov_outputs):
-        """One Shader AOV node per entry of ``aov_outputs`` (output name -> AOV name) whose value is not 0."""
+        """One Shader AOV node per entry of ``aov_outputs`` (output name, or a tuple of colour output names summed by
+        Vector Math Add nodes, -> AOV name) whose value is not 0."""
         max_depth = max(writer.depth.values()) if writer.depth else 0
-        for row, (out_name, aov_name) in enumerate(aov_outputs.items()):
-            expr = outputs[out_name]
-            if expr.is_const and not any(expr.attr("value")):
+        for row, (out_names, aov_name) in enumerate(aov_outputs.items()):
+            names = (out_names,) if isinstance(out_names, str) else tuple(out_names)
+            exprs = [outputs[n] for n in names if not (outputs[n].is_const and not any(outputs[n].attr("value")))]
+            if not exprs:
                 continue                          # an AOV never written reads 0
+            x, y = (max_depth + 3) * COLUMN_WIDTH, -(row + 2) * ROW_HEIGHT
             aov = ng.nodes.new("ShaderNodeOutputAOV")
             aov.aov_name = aov_name
             aov.label = f"AOV {aov_name}"
-            aov.location = ((max_depth + 3) * COLUMN_WIDTH, -(row + 2) * ROW_HEIGHT)
-            writer.feed(aov.inputs["Color"], expr)
+            aov.location = (x, y)
+            target = aov.inputs["Color"]
+            for expr in reversed(exprs[1:]):      # (((e0 + e1) + e2) + ...), built from the AOV back
+                add = ng.nodes.new("ShaderNodeVectorMath")
+                add.operation = "ADD"
+                add.location = (x - COLUMN_WIDTH, y)
+                ng.links.new(add.outputs["Vector"], target)
+                writer.feed(add.inputs[1], expr)
+                target = add.inputs[0]
+            writer.feed(target, exprs[0])
 
-    def _write_outputs(self, ng, writer, outs, items, shader_sums, hidden):
+    def _write_outputs(self, ng, writer, outs, items, shader_sums, hidden, probe_attribute=None):
         """The Group Output node: Emission closures summed per shader output, then the plain outputs."""
         max_depth = max(writer.depth.values()) if writer.depth else 0
         outputs = dict(outs)
@@ -381,6 +394,8 @@ class _Emitter:
                 ng.links.new(total, add.inputs[0])
                 ng.links.new(emission.outputs[0], add.inputs[1])
                 total = add.outputs[0]
+            if total is not None and probe_attribute:
+                total = _probe_switch(ng, total, probe_attribute, ((max_depth + 2) * COLUMN_WIDTH, -row * ROW_HEIGHT))
             if total is not None:
                 ng.links.new(total, socket_by_identifier(group_out.inputs, items[(shader_name, "OUTPUT")].identifier))
         group_out.location = ((max_depth + 3) * COLUMN_WIDTH, 0.0)
@@ -394,6 +409,23 @@ class _Emitter:
                 item.default_value = _socket_value(sock, expr.attr("value"))
             else:
                 ng.links.new(writer.produced[expr.id], sock)
+
+
+def _probe_switch(ng, shader, attribute, location):
+    """Mix Shader(``shader``, a white Diffuse BSDF) with the factor of the View Layer attribute ``attribute`` (0 where
+    the view layer has no such property); returns its output."""
+    x, y = location
+    fac = ng.nodes.new("ShaderNodeAttribute")
+    fac.attribute_type = "VIEW_LAYER"
+    fac.attribute_name = fac.label = attribute
+    diffuse = ng.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    mix = ng.nodes.new("ShaderNodeMixShader")
+    fac.location, diffuse.location, mix.location = (x, y + 300.0), (x, y - 300.0), (x + COLUMN_WIDTH, y)
+    ng.links.new(fac.outputs["Fac"], mix.inputs["Fac"])
+    ng.links.new(shader, mix.inputs[1])
+    ng.links.new(diffuse.outputs[0], mix.inputs[2])
+    return mix.outputs[0]
 
 
 def build_node_group(name, outputs, input_order=None, tables=None):
@@ -425,17 +457,19 @@ def ensure_function_group(function, tables=None):
 
 
 def ensure_tree(name, function, interface_inputs, sockets=None, internal_inputs=None, stamp_extra="", tables=None,
-                shader_sums=None, aov_outputs=None):
+                shader_sums=None, aov_outputs=None, probe_attribute=None):
     """A named group computing the traced ``function`` (an ``expr.Function``): ``interface_inputs`` become
     its interface (described by ``sockets``, (inputs, outputs) name -> Socket, default the function's),
     the other inputs are produced inside the tree (``internal_inputs``: name -> callable(nodes, links)
-    giving a socket).  ``shader_sums`` and ``aov_outputs``: as ``_Emitter.fill``.  Rebuilt only when the function's
+    giving a socket).  ``shader_sums``, ``aov_outputs`` and ``probe_attribute``: as ``_Emitter.fill``.  Rebuilt only when the function's
     structure, ``stamp_extra`` or the AOVs change; returns (group, rebuilt)."""
     if not isinstance(function, Function):
         raise TypeError("ensure_tree emits a traced expr.Function")
     stamp = f"{EMITTER_VERSION}:{function.key}:{sorted(interface_inputs)}:{stamp_extra}:{shader_sums!r}"
     if aov_outputs:
-        stamp += f":aovs {sorted(aov_outputs.items())!r}"
+        stamp += f":aovs {sorted(aov_outputs.items(), key=lambda item: str(item[0]))!r}"
+    if probe_attribute:
+        stamp += f":probe {probe_attribute}"
     ng = bpy.data.node_groups.get(name)
     if ng is not None and ng.get(STAMP_KEY) == stamp:
         return ng, False
@@ -451,7 +485,7 @@ def ensure_tree(name, function, interface_inputs, sockets=None, internal_inputs=
     try:
         _Emitter(tables).fill(ng, function.outputs, list(interface_inputs), sockets or function.sockets,
                               internal_inputs=internal_inputs, description=function.description, shader_sums=shader_sums,
-                              aov_outputs=aov_outputs)
+                              aov_outputs=aov_outputs, probe_attribute=probe_attribute)
     except BaseException:
         if in_use is not None:          # the group in use stays as it was
             bpy.data.node_groups.remove(ng)

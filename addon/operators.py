@@ -174,29 +174,35 @@ class RTL_OT_sync_lights(bpy.types.Operator):
 
 
 class RTL_OT_enable_shadows(bpy.types.Operator):
-    """Shadow the RT Lit lights (and the world) in Cycles renders (F12): each light's RT Lit term scaled by a denoised
-    ratio of path-traced shadowed and unshadowed light (Heitz et al. 2018), from two probe view layers and a
-    compositor"""
+    """Shadow the RT Lit lights in F12 renders of the scene's engine.  Cycles: each light's RT Lit term (and the
+    world's) scaled by a denoised ratio of path-traced shadowed and unshadowed light (Heitz et al. 2018), from two probe
+    view layers and a compositor.  EEVEE: the lights' RT Lit terms scaled by EEVEE's own Shadow pass of a white probe
+    view layer (one ratio for all lights)"""
 
     bl_idname = "rtl.enable_shadows"
     bl_label = "Enable RT Lit Shadows"
     bl_options = {'REGISTER', 'UNDO'}
 
     samples: bpy.props.IntProperty(name="Shadow Samples", default=4, min=1, max=4096,
-                                   description="Samples of the probe view layers: more is less noise, more time")
+                                   description="Cycles: samples of the probe view layers: more is less noise, more "
+                                               "time (EEVEE's probe renders with the scene's samples)")
     denoise: bpy.props.BoolProperty(name="Denoise", default=True,
-                                    description="Denoise the shadowed and unshadowed estimates (Open Image Denoise)")
+                                    description="Cycles: denoise the shadowed and unshadowed estimates (Open Image "
+                                                "Denoise)")
     world: bpy.props.BoolProperty(name="Shadow the World", default=True,
-                                  description="The world's light occluded too, by its path-traced light on a white "
-                                              "probe over RT Lit's own: in Cycles the world's diffuse light becomes "
-                                              "the path-traced one (no longer the SH of EEVEE and engines)")
+                                  description="Cycles only: the world's light occluded too, by its path-traced light "
+                                              "on a white probe over RT Lit's own: in Cycles the world's diffuse light "
+                                              "becomes the path-traced one (no longer the SH of EEVEE and engines); "
+                                              "in EEVEE the world keeps the material's World Occlusion")
 
     @classmethod
     def poll(cls, context):
+        from . import shadows
+
         if not _scene_exists(cls, context):
             return False
-        if context.scene.render.engine != 'CYCLES':
-            cls.poll_message_set("RT Lit shadows are computed by Cycles: set the render engine to Cycles")
+        if shadows.render_engine_shadows(context.scene) is None:
+            cls.poll_message_set("RT Lit shadows are computed by Cycles or EEVEE: set the render engine to one of them")
             return False
         return True
 
@@ -209,8 +215,13 @@ class RTL_OT_enable_shadows(bpy.types.Operator):
         except shadows.ShadowError as ex:
             self.report({'ERROR'}, str(ex))
             return {'CANCELLED'}
+        settings = shadows.shadow_settings(context.scene)
         lights = len(shadows.shadowed_lights(context.scene))
-        world = " and the world" if shadows.shadow_settings(context.scene)["world"] else ""
+        if settings["engine"] == "EEVEE":
+            self.report({'INFO'}, f"RT Lit shadows on: {lights} lights by EEVEE's Shadow pass (EEVEE F12 renders; the "
+                                  "world keeps World Occlusion; Cycles and the viewport stay unshadowed)")
+            return {'FINISHED'}
+        world = " and the world" if settings["world"] else ""
         self.report({'INFO'}, f"RT Lit shadows on: {lights} lights{world}, {self.samples} shadow samples"
                               f"{', denoised' if self.denoise else ''} (Cycles F12 renders; EEVEE and the viewport "
                               "stay unshadowed)")

@@ -46,10 +46,26 @@ backend keep the SH and ``Features.occlusion``.  Measured in docs/shadows.md (th
 
 A scene that already has a compositor is refused (``ShadowError``): this module does not edit a graph it did not
 make.  The AOV nodes are in the RT Lit Cycles trees only while shadows are on (the groups are rebuilt on enable and
-disable): EEVEE compiles an AOV node's inputs whatever the Material Output's target (``materials.AOV_ENGINES``), so
-while shadows are on, render with Cycles.  ``disable_shadows`` removes everything ``enable_shadows`` made; Sync
-Lights rebuilds the copies (``light_sync.sync_lights`` calls ``refresh_shadows``).  Cycles only: EEVEE renders the probe layers but writes no
-light-group passes (EEVEE's own Shadow pass is the way there, not built yet).
+disable): EEVEE compiles an AOV node's inputs whatever the Material Output's target (materials.py, before
+``shadow_engine``), so while Cycles shadows are on, render with Cycles.  ``disable_shadows`` removes everything
+``enable_shadows`` made; Sync Lights rebuilds the copies (``light_sync.sync_lights`` calls ``refresh_shadows``).
+
+EEVEE (``enable_shadows`` on a scene that renders with EEVEE; ``shadow_settings(scene)["engine"]`` = "EEVEE"): EEVEE
+draws no light-group passes, but its Shadow pass (``ViewLayer.use_pass_shadow``) is, per pixel, EEVEE's shadowed
+over its unshadowed diffuse light, all lights summed (measured by the spike of issue 29: docs/shadows.md).  So:
+
+- the RT Lit EEVEE trees write the sum of the lights' radiance to the Shader AOV "RTL Lights"
+  (``common.LIGHTS_AOV``), declared on the beauty layer; the Cycles trees then carry no AOV;
+- one probe view layer ``EEVEE_PROBE`` (the beauty layer's collections, the scene's own lights: no copies, a black
+  world: ``PROBE_WORLD``) renders every object white diffuse and writes the Shadow pass: by ``material_override`` in 5.x, and on 4.5, where EEVEE
+  ignores the override in renders and gives a Shadow pass of 0 on an emission-only (or black) surface, by the RT Lit
+  EEVEE trees' switch to a white Diffuse BSDF on the view layer property ``common.PROBE_LAYER_ATTRIBUTE`` (1 there);
+- the compositor: ``final = beauty + AOV_lights * (clamp(Shadow, 0, 1) - 1)``.
+
+One ratio scales all lights together (where one light is blocked and another is not, the sum is off: the Cycles
+path's per-light ratio is exact there), and the World term is not shadowed by it (``world`` is a Cycles option; in
+EEVEE it keeps ``Features.occlusion``).  Soft shadows are EEVEE's (its shadow-map filtering, or the lights'
+``use_shadow_jitter`` with enough samples: not set here, they are the user's lights).
 """
 from __future__ import annotations
 
@@ -58,11 +74,18 @@ from pathlib import Path
 import bpy
 
 from . import compat, materials, preferences, world_sync
-from .common import SHADOW_COPY_KEY, SHADOWS_KEY, light_aov_name, node_groups_kept_on_error
+from .common import LIGHTS_AOV, PROBE_LAYER_ATTRIBUTE, SHADOW_COPY_KEY, SHADOWS_KEY, light_aov_name, node_groups_kept_on_error
 
 #: The probe view layers: (role, view layer name, collection of the light copies, light-group prefix, shadowed).
 PROBES = (("S", "RTL Probe S", "RTL Shadow Lights S", "s_", True),
           ("U", "RTL Probe U", "RTL Shadow Lights U", "u_", False))
+#: EEVEE's probe view layer (EEVEE shadows: the scene's own lights, no copies; its Shadow pass).
+EEVEE_PROBE = "RTL Probe Shadow"
+#: EEVEE's probe layer's world (``ViewLayer.world_override``): black.  EEVEE (4.2 on) extracts a shadow-casting sun
+#: from a bright world, which took part in the Shadow pass (the floor study: |Shadow - Cycles' sum S / sum U| median
+#: 0.12 with the scene's world in the probe, 0.06 with a black one; docs/shadows.md); RT Lit's World term is not
+#: shadowed by the pass, so the probe sees the lights alone.
+PROBE_WORLD = "RTL Shadow Probe World"
 #: The material every object has in the probe layers (``ViewLayer.material_override``).
 PROBE_MATERIAL = "RTL Shadow Probe"
 #: The compositor's node group (Blender 5) or the marker name of its nodes (4.5).
@@ -90,13 +113,22 @@ def shadows_enabled(scene):
 
 
 def shadow_settings(scene):
-    """{"samples", "denoise", "beauty", "world"} of a scene with shadows on, or None."""
+    """{"engine", "samples", "denoise", "beauty", "world"} of a scene with shadows on, or None.  "engine": "Cycles"
+    or "EEVEE", the engine they were built for; "samples", "denoise" and "world" are Cycles options (with EEVEE:
+    0, False, False)."""
     stored = scene.get(SHADOWS_KEY)
     if stored is None:
         return None
     stored = stored.to_dict() if hasattr(stored, "to_dict") else dict(stored)
-    return {"samples": int(stored["samples"]), "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"]),
-            "world": bool(stored.get("world", False))}
+    return {"engine": str(stored.get("engine", "Cycles")), "samples": int(stored["samples"]),
+            "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"]), "world": bool(stored.get("world", False))}
+
+
+def render_engine_shadows(scene):
+    """The shadow engine ("Cycles", "EEVEE") of ``scene.render.engine``, or None when RT Lit shadows have none for
+    it."""
+    engine = scene.render.engine
+    return "Cycles" if engine == "CYCLES" else "EEVEE" if engine == compat.eevee_engine() else None
 
 
 def shadowed_lights(scene):
@@ -111,41 +143,54 @@ def light_group_name(role, index):
 
 
 def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None, world=True):
-    """Shadow RT Lit materials in ``scene``'s Cycles renders (Heitz et al. 2018's ratio estimator; module docstring).
+    """Shadow RT Lit materials in ``scene``'s F12 renders with the engine it renders with: Cycles (Heitz et al.
+    2018's ratio estimator; module docstring) or EEVEE (its Shadow pass; "EEVEE" in the module docstring: ``samples``,
+    ``denoise`` and ``world`` are not used there).
 
     ``samples``: the probe layers' samples per pixel; ``denoise``: Open Image Denoise on each S and U pass;
     ``view_layer``: the name of the view layer whose render is shadowed (default: the first one that renders).
     The lights are those of the last light sync (``materials.synced_light_kinds``, the AOVs' indices).  ``world``:
     shadow the World term too (when the scene has a world and RT Lit a World term; its part of the module docstring): the Cycles trees then
     leave out ``Features.occlusion`` (the ratio is the world's occlusion there).  The RT Lit groups are rebuilt with
-    the AOVs in their Cycles trees (``materials.AOV_ENGINES``; ``lut_dir``: the tables, default the preferences').
+    the AOVs in the trees of the shadows' engine (``materials.shadow_engine``; ``lut_dir``: the tables, default the
+    preferences').
     Enabling again rebuilds everything (the same result).  Raises ``ShadowError`` (changing nothing) when the scene
-    renders with another engine, has nothing to shadow (no synced light, and no world or ``world`` False), or has a
-    compositor of its own."""
-    _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups=True, world=world)
+    renders with another engine (or EEVEE with its shadows off), has nothing to shadow (no synced light, and no world
+    or ``world`` False), or has a compositor of its own."""
+    engine = render_engine_shadows(scene)
+    if engine is None:
+        raise ShadowError(f"RT Lit shadows need Cycles or EEVEE (the scene renders with {scene.render.engine})")
+    _enable(scene, engine, samples, denoise, view_layer, lut_dir, rebuild_groups=True, world=world)
 
 
-def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups, world):
+def _enable(scene, engine, samples, denoise, view_layer, lut_dir, rebuild_groups, world):
     settings = shadow_settings(scene)
-    if scene.render.engine != "CYCLES":
-        raise ShadowError(f"RT Lit shadows need Cycles (the scene renders with {scene.render.engine})")
+    if engine == "EEVEE" and not scene.eevee.use_shadows:
+        raise ShadowError("EEVEE's shadows are off in this scene (Render Properties > Shadows): RT Lit shadows in "
+                          "EEVEE read EEVEE's own Shadow pass")
     tree = compat.compositor_tree(scene)
     if tree is not None and not tree.get(SHADOWS_KEY):
         raise ShadowError("The scene has a compositor of its own; RT Lit shadows build theirs and do not edit another "
                           "one: remove it (or its nodes) first")
-    requested, world = bool(world), bool(world) and scene.world is not None and world_sync.world_synced()
+    requested = bool(world)
+    world = requested and engine == "Cycles" and scene.world is not None and world_sync.world_synced()
+    if engine == "EEVEE":               # EEVEE's probe renders with the scene's samples, undenoised
+        samples, denoise = 0, False
     lights = _synced_lights(scene, allow_none=world)
     beauty = _beauty_layer(scene, view_layer or (settings["beauty"] if settings is not None else None))
     use_compositing = bool(scene[SHADOWS_KEY]["use_compositing"]) if settings is not None \
         else bool(scene.render.use_compositing)
     if settings is not None:
         _remove_parts(scene)
-    scene[SHADOWS_KEY] = {"samples": int(samples), "denoise": bool(denoise), "beauty": beauty.name,
+    scene[SHADOWS_KEY] = {"engine": engine, "samples": int(samples), "denoise": bool(denoise), "beauty": beauty.name,
                           "use_compositing": use_compositing, "aovs": [], "world": world, "world_requested": requested}
     if world:
         scene[SHADOWS_KEY]["world_lightgroup"] = str(scene.world.lightgroup)
     try:
-        _build(scene, beauty, lights, int(samples), bool(denoise), world)
+        if engine == "EEVEE":
+            _build_eevee(scene, beauty)
+        else:
+            _build(scene, beauty, lights, int(samples), bool(denoise), world)
         if rebuild_groups:              # the AOVs in the RT Lit Cycles trees (kept when they are there)
             _rebuild_groups(scene, lut_dir)
     except BaseException:
@@ -161,8 +206,8 @@ def refresh_shadows(scene, lut_dir=None):
     if settings is None:
         return False
     requested = bool(scene[SHADOWS_KEY].get("world_requested", settings["world"]))
-    _enable(scene, settings["samples"], settings["denoise"], settings["beauty"], lut_dir, rebuild_groups=False,
-            world=requested)
+    _enable(scene, settings["engine"], settings["samples"], settings["denoise"], settings["beauty"], lut_dir,
+            rebuild_groups=False, world=requested)
     return True
 
 
@@ -174,9 +219,12 @@ def disable_shadows(scene, lut_dir=None):
         return
     _remove_parts(scene)
     del scene[SHADOWS_KEY]
-    material = bpy.data.materials.get(PROBE_MATERIAL)
-    if material is not None and not any(shadows_enabled(other) for other in bpy.data.scenes):
-        bpy.data.materials.remove(material)
+    if not any(shadows_enabled(other) for other in bpy.data.scenes):
+        material, world = bpy.data.materials.get(PROBE_MATERIAL), bpy.data.worlds.get(PROBE_WORLD)
+        if material is not None:
+            bpy.data.materials.remove(material)
+        if world is not None:
+            bpy.data.worlds.remove(world)
     _rebuild_groups(scene, lut_dir)
 
 
@@ -206,7 +254,7 @@ def _remove_parts(scene):
             aov = beauty.aovs.get(name)
             if aov is not None:
                 beauty.aovs.remove(aov)
-    for _, layer_name, collection_name, _, _ in PROBES:
+    for layer_name in _probe_layer_names():
         layer = scene.view_layers.get(layer_name)
         if layer is not None:
             scene.view_layers.remove(layer)
@@ -219,8 +267,13 @@ def _remove_parts(scene):
 
 # --- the parts ----------------------------------------------------------------------------------------------------
 
+def _probe_layer_names():
+    """The names of the view layers ``enable_shadows`` makes (Cycles' and EEVEE's)."""
+    return {layer_name for _, layer_name, _, _, _ in PROBES} | {EEVEE_PROBE}
+
+
 def _beauty_layer(scene, name):
-    probes = {layer_name for _, layer_name, _, _, _ in PROBES}
+    probes = _probe_layer_names()
     if name is not None:
         layer = scene.view_layers.get(name)
         if layer is None or layer.name in probes:
@@ -292,6 +345,52 @@ def _build(scene, beauty, lights, samples, denoise, world):
     _build_compositor(scene, beauty, layers, [index for index, _ in lights], denoise, world)
 
 
+def _build_eevee(scene, beauty):
+    """EEVEE shadows: the beauty layer declares ``LIGHTS_AOV`` (the RT Lit EEVEE tree writes the sum of the lights'
+    radiance there); the probe layer ``EEVEE_PROBE`` renders every object of the beauty layer's collections with the
+    white diffuse probe material, lit by the scene's own lights, and writes EEVEE's Shadow pass; the compositor
+    applies it (``_build_eevee_compositor``)."""
+    stored = scene[SHADOWS_KEY]
+    if beauty.aovs.get(LIGHTS_AOV) is None:
+        aov = beauty.aovs.add()
+        aov.name = LIGHTS_AOV
+        aov.type = "COLOR"
+        stored["aovs"] = [LIGHTS_AOV]
+    excluded = _excluded_names(beauty)
+    layer = scene.view_layers.new(EEVEE_PROBE)
+    layer.material_override = _probe_material()    # 5.x; on 4.5 the RT Lit EEVEE trees switch by the property
+    layer[PROBE_LAYER_ATTRIBUTE] = 1.0
+    layer.world_override = _probe_world()
+    layer.use_pass_shadow = True
+    for child in _layer_collections(_root_collection(layer)):
+        if child.name in excluded:
+            child.exclude = True
+    scene.render.use_compositing = True
+    scene.render.use_single_layer = False
+    _build_eevee_compositor(scene, beauty, layer)
+
+
+def _build_eevee_compositor(scene, beauty, probe):
+    """final = beauty + AOV_lights * (clamp(Shadow, 0, 1) - 1), written as beauty - AOV + AOV * Shadow (the beauty's
+    alpha kept).  EEVEE's Shadow pass is, per pixel, EEVEE's shadowed over its unshadowed diffuse light of the white
+    probe, all lights summed (measured: docs/shadows.md), so one ratio scales the sum of the lights' RT Lit terms."""
+    tree, result = compat.new_compositor(scene, COMPOSITOR_NAME)
+    tree[SHADOWS_KEY] = True
+    render = {}
+    for row, layer in enumerate((beauty, probe)):
+        node = tree.nodes.new("CompositorNodeRLayers")
+        node.scene = scene
+        node.layer = layer.name
+        node.location = (-900.0, -row * 400.0)
+        render[layer.name] = node
+    shadow = compat.mix_colors(tree, render[probe.name].outputs["Shadow"], (0.0,) * 3, "ADD", clamp=True)
+    aov = render[beauty.name].outputs[LIGHTS_AOV]
+    image = compat.mix_colors(tree, render[beauty.name].outputs["Image"], aov, "SUBTRACT")
+    image = compat.mix_colors(tree, image, compat.mix_colors(tree, aov, shadow, "MULTIPLY"), "ADD")
+    tree.links.new(image, result)
+    return tree
+
+
 def _root_collection(layer):
     """The scene collection's layer collection of view ``layer``.  A view layer of a scene made in this session
     (``bpy.data.scenes.new``) has none until it is synced (``ViewLayer.update``; measured with 5.2.3)."""
@@ -336,6 +435,17 @@ def _probe_material():
     links.new(mix.outputs[0], output.inputs["Surface"])
     path.location, diffuse.location, mix.location = (-400.0, 200.0), (-400.0, -100.0), (-150.0, 0.0)
     return material
+
+
+def _probe_world():
+    """A black world (colour 0; its Background nodes at strength 0): EEVEE's probe layer's ``world_override``."""
+    world = bpy.data.worlds.get(PROBE_WORLD) or compat.new_world(PROBE_WORLD)
+    world.color = (0.0, 0.0, 0.0)
+    for node in world.node_tree.nodes if world.node_tree is not None else ():
+        if node.bl_idname == "ShaderNodeBackground":
+            node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+            node.inputs["Strength"].default_value = 0.0
+    return world
 
 
 def _light_copy(scene, original, collection, group, shadowed):

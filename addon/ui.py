@@ -38,11 +38,18 @@ def draw_shadows(layout, scene):
         box.operator("rtl.enable_shadows", icon='LIGHT_SUN')
         box.label(text="Lights unshadowed in every engine", icon='INFO')
         return
-    box.label(text=f"Shadows: {settings['samples']} samples{', denoised' if settings['denoise'] else ''}",
-              icon='CHECKMARK')
-    box.label(text="Cycles F12: lights " + ("and world shadowed" if settings["world"] else "shadowed")
-              + " (ratio estimator)", icon='BLANK1')
-    box.label(text="EEVEE, viewport: lights unshadowed", icon='BLANK1')
+    if settings["engine"] == "EEVEE":
+        box.label(text="Shadows: EEVEE's Shadow pass (one ratio for all lights)", icon='CHECKMARK')
+        box.label(text="EEVEE F12: lights shadowed; world as World Occlusion says", icon='BLANK1')
+        box.label(text="Cycles, viewport: lights unshadowed (enable again in Cycles)", icon='BLANK1')
+    else:
+        box.label(text=f"Shadows: {settings['samples']} samples{', denoised' if settings['denoise'] else ''}",
+                  icon='CHECKMARK')
+        box.label(text="Cycles F12: lights " + ("and world shadowed" if settings["world"] else "shadowed")
+                  + " (ratio estimator)", icon='BLANK1')
+        box.label(text="EEVEE, viewport: lights unshadowed (enable again in EEVEE)", icon='BLANK1')
+    if shadows.render_engine_shadows(scene) != settings["engine"]:
+        box.label(text=f"Set up for {settings['engine']}: the scene renders with another engine", icon='ERROR')
     box.operator("rtl.disable_shadows", icon='X')
 
 

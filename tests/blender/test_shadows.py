@@ -181,6 +181,7 @@ def _state(bpy, scene):
                          for vl in scene.view_layers},
             "objects": names(bpy.data.objects), "lights": names(bpy.data.lights),
             "collections": names(bpy.data.collections), "materials": names(bpy.data.materials),
+            "worlds": names(bpy.data.worlds),
             "node groups": names(bpy.data.node_groups), "compositor": compat.compositor_tree(scene) is not None,
             "aov nodes": sorted(n.aov_name for ng in bpy.data.node_groups if ng.bl_idname == "ShaderNodeTree"
                                 for n in ng.nodes if n.bl_idname == "ShaderNodeOutputAOV"),
@@ -299,7 +300,7 @@ def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(re
     scene's lights only (the probes' light copies render in the probe layers, not in the twin), disable undoes it."""
     import bpy
 
-    from rt_lookdev.addon import lookdev_scene, shadows
+    from rt_lookdev.addon import compat, lookdev_scene, shadows
     from rt_lookdev.addon.common import SHADOW_COPY_KEY
 
     scene = _scene(bpy, lut_dir, [("Key", "AREA", (0.0, 0.0, 3.0), 200.0, 0.4)])
@@ -309,13 +310,22 @@ def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(re
     assert not bpy.ops.rtl.enable_shadows.poll()
     scene.render.engine = engine
     assert bpy.ops.rtl.enable_shadows(samples=2, denoise=False) == {'FINISHED'}
-    assert shadows.shadow_settings(scene) == {"samples": 2, "denoise": False, "beauty": "ViewLayer", "world": False}
+    assert shadows.shadow_settings(scene) == {"engine": "Cycles", "samples": 2, "denoise": False, "beauty": "ViewLayer",
+                                              "world": False}
     assert shadows.shadowed_lights(scene) == [0]
     twin = lookdev_scene.add_path_traced_twin(scene)
     assert not [o.name for o in twin.objects if SHADOW_COPY_KEY in o]
     assert [o.name for o in twin.objects if o.type == "LIGHT"] == ["Key"]
     assert bpy.ops.rtl.disable_shadows() == {'FINISHED'}
     assert not shadows.shadows_enabled(scene) and not bpy.ops.rtl.disable_shadows.poll()
+    scene.render.engine = compat.eevee_engine()             # EEVEE: its Shadow pass, no light copies, no world option
+    assert bpy.ops.rtl.enable_shadows.poll()
+    assert bpy.ops.rtl.enable_shadows(world=True) == {'FINISHED'}
+    assert shadows.shadow_settings(scene) == {"engine": "EEVEE", "samples": 0, "denoise": False, "beauty": "ViewLayer",
+                                              "world": False}
+    assert not [o.name for o in scene.objects if SHADOW_COPY_KEY in o]
+    assert bpy.ops.rtl.disable_shadows() == {'FINISHED'}
+    assert not shadows.shadows_enabled(scene)
 
 
 def test_world_shadows_darken_the_floor_and_disable_restores(empty_scene, lut_dir, tmp_path):
@@ -398,3 +408,96 @@ def test_world_shadows_take_the_place_of_world_occlusion_in_cycles_only(empty_sc
     shadows.enable_shadows(scene, samples=1, denoise=False, lut_dir=lut_dir)
     shadows.disable_shadows(scene, lut_dir)
     assert all(_ao_nodes(t) for t in trees("Cycles")) and all(_ao_nodes(t) for t in trees("EEVEE"))
+
+
+# --- EEVEE: its own Shadow pass ------------------------------------------------------------------------------------
+
+EEVEE_SAMPLES = 4           # EEVEE's samples per pixel (beauty and probe layer)
+
+
+def _eevee_scene(bpy, lut_dir, lights):
+    """The floor and box scene of ``_scene`` rendered by EEVEE (its shadows on, the film filter 0, ``EEVEE_SAMPLES``)."""
+    from rt_lookdev.validation.harness.render_setup import configure_eevee_measurement
+
+    scene = _scene(bpy, lut_dir, lights)
+    world = scene.world
+    configure_eevee_measurement(scene, samples=EEVEE_SAMPLES, black_world=False)
+    scene.world = world
+    scene.eevee.use_shadows = True
+    return scene
+
+
+def test_eevee_umbra_is_dark_and_lit_floor_keeps_rt_lit(empty_scene, lut_dir, tmp_path):
+    """EEVEE mode (``enable_shadows`` on a scene that renders with EEVEE): the beauty's "RTL Lights" AOV is the lights'
+    RT Lit radiance, the umbra goes dark, the lit floor keeps the RT Lit value (EEVEE's Shadow pass is 1 there)."""
+    import bpy
+
+    from rt_lookdev.addon import shadows
+
+    scene = _eevee_scene(bpy, lut_dir, [("Key", "AREA", (0.0, 0.0, 3.0), 300.0, 0.4)])
+    plain, t_plain = _render(bpy, scene, tmp_path / "plain.exr")
+    shadows.enable_shadows(scene)
+    settings = shadows.shadow_settings(scene)
+    assert settings["engine"] == "EEVEE" and settings["world"] is False
+    shaded, t_shadows = _render(bpy, scene, tmp_path / "shadows.exr")
+    ref, got = plain["final"], shaded["final"]
+    assert np.all(np.isfinite(got))
+    umbra, lit = _regions()
+    level = ref[lit].mean()
+    assert level > 0.1 and ref[umbra].min() > 0.5 * level
+    beauty = scene.view_layers[0].name
+    np.testing.assert_allclose(shaded[f"{beauty}.Combined"], ref, rtol=2e-3, atol=1e-6)     # EEVEE's half floats
+    np.testing.assert_allclose(shaded[f"{beauty}.RTL Lights"], ref, rtol=2e-3, atol=1e-6)   # one light, no world
+    rel = np.abs(got - ref)[lit] / ref[lit]
+    print(f"EEVEE: umbra max {got[umbra].max() / level:.3g} of the lit level; lit rel. error median "
+          f"{np.median(rel):.3g}, max {rel.max():.3g}; F12 {t_plain:.2f} s without, {t_shadows:.2f} s with shadows")
+    assert got[umbra].max() < 0.01 * level
+    assert np.median(rel) < 2e-3 and rel.max() < 0.05
+
+
+def test_eevee_disable_restores_and_reload_keeps_it(empty_scene, lut_dir, tmp_path):
+    """EEVEE mode: one probe layer and one AOV (no light copies), the AOV node in the EEVEE trees only; disable
+    removes everything and the render is bit-identical to the one before; a saved file re-opens with it (the same
+    render); enabling again with Cycles switches the mode (the AOVs move to the Cycles trees)."""
+    import bpy
+
+    from rt_lookdev.addon import compat, shadows
+
+    scene = _eevee_scene(bpy, lut_dir, [("Key", "AREA", (0.0, 0.0, 3.0), 300.0, 0.4)])
+    scene.render.use_compositing = False
+    before = _state(bpy, scene)
+    plain, _ = _render(bpy, scene, tmp_path / "before.exr")
+    shadows.enable_shadows(scene)
+    once = _state(bpy, scene)
+    assert set(once["view layers"]) - set(before["view layers"]) == {shadows.EEVEE_PROBE}
+    assert once["objects"] == before["objects"] and once["compositor"]
+    assert scene.view_layers[shadows.EEVEE_PROBE].world_override.name == shadows.PROBE_WORLD   # no world sun there
+    assert once["aovs"]["ViewLayer"] == ["RTL Lights"] and once["aov nodes"] == ["RTL Lights"]
+    assert all(ng.name.endswith("[EEVEE]") for ng in bpy.data.node_groups
+               if any(n.bl_idname == "ShaderNodeOutputAOV" for n in ng.nodes))
+    shadows.enable_shadows(scene)
+    assert _state(bpy, scene) == once
+    scene.eevee.use_shadows = False
+    with pytest.raises(shadows.ShadowError, match="EEVEE's shadows are off"):
+        shadows.enable_shadows(scene)
+    assert _state(bpy, scene) == once
+    scene.eevee.use_shadows = True
+    blend = tmp_path / "eevee_shadows.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    shaded, _ = _render(bpy, scene, tmp_path / "shaded.exr")
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    scene = bpy.context.scene
+    assert shadows.shadow_settings(scene)["engine"] == "EEVEE" and _state(bpy, scene) == once
+    reloaded, _ = _render(bpy, scene, tmp_path / "reloaded.exr")
+    np.testing.assert_array_equal(reloaded["final"], shaded["final"])
+    shadows.disable_shadows(scene)
+    assert _state(bpy, scene) == before
+    again, _ = _render(bpy, scene, tmp_path / "after.exr")
+    np.testing.assert_array_equal(again["final"], plain["final"])
+    scene.render.engine = "CYCLES"                          # enabled again with Cycles: the Cycles mode
+    shadows.enable_shadows(scene, samples=2)
+    assert shadows.shadow_settings(scene)["engine"] == "Cycles"
+    assert _state(bpy, scene)["aov nodes"] == ["RTL Light 0"]
+    shadows.disable_shadows(scene)
+    scene.render.engine = compat.eevee_engine()
+    assert _state(bpy, scene) == before

@@ -399,3 +399,96 @@ def run(out_dir, lut_dir=None, resolution=(320, 160), samples=256, eevee=True, p
     (out_dir / "lookdev.md").write_text(result["summary_markdown"])
     result["images"] = images
     return result
+
+
+# --- EEVEE's light shadows against Cycles' (issue 29) -----------------------------------------------------------------
+
+def render_eevee_measurement(scene, resolution, samples, folder):
+    """EEVEE with the measurement settings of ``render_setup.configure_eevee_measurement`` (film filter 0), but the
+    scene's world and EEVEE's shadows on, transparent film: (RGB (H, W, 3), seconds).  A scene with RT Lit shadows on
+    renders through its compositor (the RGB is the composited image)."""
+    import bpy
+
+    from ...addon import compat, shadows
+    from ..harness.engines import output_settings
+    from ..harness.render_setup import configure_eevee_measurement, eevee_texture_filtering
+
+    exr = Path(folder) / f"{scene.name.replace(' ', '_')}_eevee.exr"
+    world = scene.world
+    with _kept_settings(scene):
+        configure_eevee_measurement(scene, samples=samples, black_world=False)
+        scene.world = world
+        scene.eevee.use_shadows = True
+        output_settings(scene, *resolution, exr)
+        scene.render.film_transparent = True
+        shadowed = shadows.shadows_enabled(scene)
+        scene.render.use_compositing = shadowed
+        compat.set_exr_output(scene.render.image_settings, multilayer=True)
+        with eevee_texture_filtering():
+            t0 = time.perf_counter()
+            bpy.ops.render.render(write_still=True, scene=scene.name)
+            seconds = time.perf_counter() - t0
+    ch = exr_images.read_channels(exr)
+    if shadowed:
+        return np.stack([ch[f"Composite.Combined.{c}"] for c in "RGB"], axis=-1).astype(np.float64), seconds
+    return exr_images.find_pass(ch, "Combined", "RGB").astype(np.float64), seconds
+
+
+def eevee_shadow_study(lut_dir=None, resolution=(160, 100), eevee_samples=16, jitter=False, cycles_shadows=None,
+                       log=print):
+    """EEVEE with RT Lit shadows (its Shadow pass, addon/shadows.py) against Cycles with RT Lit shadows (the ratio
+    estimator, ``world=False``: EEVEE does not shadow the World term) on the floor study's scene
+    (``new_lookdev_scene(floor=True)``, the studio lights and world, ``Features()``), and EEVEE against Cycles
+    without shadows for reference.  ``eevee_samples``: EEVEE's samples per pixel; ``jitter``: the lights'
+    ``use_shadow_jitter`` (EEVEE's soft shadows by jittered shadow maps); ``cycles_shadows``: the options of
+    ``enable_shadows`` for Cycles (default 4 spp, OIDN).  Per-pixel relative error (``metrics.rel_values``) over the
+    floor's and the spheres' interior pixels: {"floor", "spheres"} x {"shadows", "no_shadows"} of {"median", "p90",
+    ...}, and the seconds of each F12."""
+    import bpy
+
+    from ...addon import compat, lookdev_scene, shadows
+    from ...core.materials.rt_lit_interface import Features
+
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = lookdev_scene.new_lookdev_scene("EEVEE Shadow Study", Features(), view_transform="Standard",
+                                            lut_dir=lut_dir, floor=True)
+    objects = lookdev_scene.lookdev_spheres(scene)
+    for i, obj in enumerate(objects, start=1):
+        obj.pass_index = i
+    floor_index = [o.name for o in objects].index(f"{scene.name} Floor") + 1
+    for obj in scene.objects:
+        if obj.type == "LIGHT":
+            obj.data.use_shadow_jitter = bool(jitter)
+    cycles_shadows = dict(cycles_shadows or {"samples": 4, "denoise": True})
+    images, seconds = {}, {}
+    with tempfile.TemporaryDirectory(prefix="rtl-eevee-shadows-") as tmp:
+        scene.render.engine = "CYCLES"
+        images["cycles"], index, seconds["cycles"] = render_measurement(scene, resolution, 1, 0, tmp)
+        shadows.enable_shadows(scene, lut_dir=lut_dir, world=False, **cycles_shadows)
+        images["cycles_shadows"], _, seconds["cycles_shadows"] = render_measurement(scene, resolution, 1, 0, tmp)
+        shadows.disable_shadows(scene, lut_dir)
+        scene.render.engine = compat.eevee_engine()
+        images["eevee"], seconds["eevee"] = render_eevee_measurement(scene, resolution, eevee_samples, tmp)
+        shadows.enable_shadows(scene, lut_dir=lut_dir)
+        images["eevee_shadows"], seconds["eevee_shadows"] = render_eevee_measurement(scene, resolution,
+                                                                                     eevee_samples, tmp)
+        shadows.disable_shadows(scene, lut_dir)
+    interior = metrics.interior_pixels(index)
+    masks = {"floor": interior & (index == floor_index), "spheres": interior & (index > 0) & (index != floor_index)}
+    out = {"resolution": list(resolution), "eevee_samples": eevee_samples, "jitter": bool(jitter),
+           "cycles_shadows": cycles_shadows, "seconds": seconds}
+    for region, mask in masks.items():
+        out[region] = {}
+        for case, (a, c) in {"shadows": ("eevee_shadows", "cycles_shadows"), "no_shadows": ("eevee", "cycles")}.items():
+            rel, _ = metrics.rel_values(images[a], images[c], mask, FLOOR_FRACTION)
+            out[region][case] = _stats(rel)
+    # how much the shadows change each engine's floor (the size of what is compared)
+    rel, _ = metrics.rel_values(images["cycles_shadows"], images["cycles"], masks["floor"], FLOOR_FRACTION)
+    out["floor"]["cycles_shadows_vs_cycles"] = _stats(rel)
+    for region in masks:
+        log(f"[eevee shadows] {region}: with shadows median {out[region]['shadows']['median']:.2%} p90 "
+            f"{out[region]['shadows']['p90']:.2%}; without median {out[region]['no_shadows']['median']:.2%} p90 "
+            f"{out[region]['no_shadows']['p90']:.2%}")
+    log(f"[eevee shadows] F12 seconds {seconds}")
+    out["images"] = {k: v.astype(np.float32) for k, v in images.items()}
+    return out
