@@ -434,28 +434,61 @@ def render_eevee_measurement(scene, resolution, samples, folder):
     return exr_images.find_pass(ch, "Combined", "RGB").astype(np.float64), seconds
 
 
-def eevee_shadow_study(lut_dir=None, resolution=(160, 100), eevee_samples=16, jitter=False, cycles_shadows=None,
-                       log=print):
-    """EEVEE with RT Lit shadows (its Shadow pass, addon/shadows.py) against Cycles with RT Lit shadows (the ratio
-    estimator, ``world=False``: EEVEE does not shadow the World term) on the floor study's scene
-    (``new_lookdev_scene(floor=True)``, the studio lights and world, ``Features()``), and EEVEE against Cycles
-    without shadows for reference.  ``eevee_samples``: EEVEE's samples per pixel; ``jitter``: the lights'
-    ``use_shadow_jitter`` (EEVEE's soft shadows by jittered shadow maps); ``cycles_shadows``: the options of
-    ``enable_shadows`` for Cycles (default 4 spp, OIDN).  Per-pixel relative error (``metrics.rel_values``) over the
-    floor's and the spheres' interior pixels: {"floor", "spheres"} x {"shadows", "no_shadows"} of {"median", "p90",
-    ...}, and the seconds of each F12."""
+#: The scenes of ``eevee_shadow_study``: name -> its builder's name in addon/lookdev_scene.py.
+EEVEE_STUDY_SCENES = ("floor", "concave")
+
+
+def _eevee_study_scene(kind, lut_dir):
+    """The floor study's scene (``new_lookdev_scene(floor=True)``) or the concave scene (``new_concave_scene``),
+    ``Features()``, Standard view transform, in a fresh file; returns (scene, its RT Lit objects)."""
     import bpy
 
-    from ...addon import compat, lookdev_scene, shadows
+    from ...addon import lookdev_scene
     from ...core.materials.rt_lit_interface import Features
 
+    if kind not in EEVEE_STUDY_SCENES:
+        raise ValueError(f"unknown scene {kind!r}: one of {EEVEE_STUDY_SCENES}")
     bpy.ops.wm.read_homefile(use_empty=True)
-    scene = lookdev_scene.new_lookdev_scene("EEVEE Shadow Study", Features(), view_transform="Standard",
-                                            lut_dir=lut_dir, floor=True)
-    objects = lookdev_scene.lookdev_spheres(scene)
+    if kind == "floor":
+        scene = lookdev_scene.new_lookdev_scene("EEVEE Shadow Study", Features(), view_transform="Standard",
+                                                lut_dir=lut_dir, floor=True)
+    else:
+        scene = lookdev_scene.new_concave_scene("EEVEE Concave Study", Features(), view_transform="Standard",
+                                                lut_dir=lut_dir)
+    return scene, lookdev_scene.lookdev_spheres(scene)
+
+
+def _eevee_study_regions(kind, scene, objects, index):
+    """{region: mask}: every RT Lit object's interior pixels ("all"), and the floor study's "floor" and "spheres" or
+    each object of the concave scene (its name without the scene's)."""
+    interior = metrics.interior_pixels(index)
+    regions = {"all": interior & (index > 0)}
+    names = [o.name for o in objects]
+    if kind == "floor":
+        floor_index = names.index(f"{scene.name} Floor") + 1
+        regions["floor"] = interior & (index == floor_index)
+        regions["spheres"] = interior & (index > 0) & (index != floor_index)
+    else:
+        for i, name in enumerate(names, start=1):
+            regions[name.removeprefix(f"{scene.name} ")] = interior & (index == i)
+    return regions
+
+
+def eevee_shadow_study(lut_dir=None, resolution=(160, 100), eevee_samples=16, jitter=False, cycles_shadows=None,
+                       log=print, scene_kind="floor"):
+    """EEVEE with RT Lit shadows (its Shadow pass, addon/shadows.py) against Cycles with RT Lit shadows (the ratio
+    estimator, ``world=False``: EEVEE does not shadow the World term) on ``scene_kind``'s scene
+    (``EEVEE_STUDY_SCENES``: the floor study, the concave scene; the studio lights and world, ``Features()``), and
+    EEVEE against Cycles without shadows for reference.  ``eevee_samples``: EEVEE's samples per pixel; ``jitter``:
+    the lights' ``use_shadow_jitter`` (EEVEE's soft shadows by jittered shadow maps); ``cycles_shadows``: the options
+    of ``enable_shadows`` for Cycles (default 4 spp, OIDN).  Per-pixel relative error (``metrics.rel_values``) per
+    region (``_eevee_study_regions``): {region: {"shadows", "no_shadows"}: {"median", "p90", ...}}, how much the
+    shadows change Cycles' render ("cycles_shadows_vs_cycles", "all" region), and the seconds of each F12."""
+    from ...addon import compat, shadows
+
+    scene, objects = _eevee_study_scene(scene_kind, lut_dir)
     for i, obj in enumerate(objects, start=1):
         obj.pass_index = i
-    floor_index = [o.name for o in objects].index(f"{scene.name} Floor") + 1
     for obj in scene.objects:
         if obj.type == "LIGHT":
             obj.data.use_shadow_jitter = bool(jitter)
@@ -464,7 +497,7 @@ def eevee_shadow_study(lut_dir=None, resolution=(160, 100), eevee_samples=16, ji
     with tempfile.TemporaryDirectory(prefix="rtl-eevee-shadows-") as tmp:
         scene.render.engine = "CYCLES"
         images["cycles"], index, seconds["cycles"] = render_measurement(scene, resolution, 1, 0, tmp)
-        shadows.enable_shadows(scene, lut_dir=lut_dir, world=False, **cycles_shadows)
+        shadows.enable_shadows(scene, lut_dir=lut_dir, **dict(cycles_shadows, world=False))
         images["cycles_shadows"], _, seconds["cycles_shadows"] = render_measurement(scene, resolution, 1, 0, tmp)
         shadows.disable_shadows(scene, lut_dir)
         scene.render.engine = compat.eevee_engine()
@@ -473,22 +506,20 @@ def eevee_shadow_study(lut_dir=None, resolution=(160, 100), eevee_samples=16, ji
         images["eevee_shadows"], seconds["eevee_shadows"] = render_eevee_measurement(scene, resolution,
                                                                                      eevee_samples, tmp)
         shadows.disable_shadows(scene, lut_dir)
-    interior = metrics.interior_pixels(index)
-    masks = {"floor": interior & (index == floor_index), "spheres": interior & (index > 0) & (index != floor_index)}
-    out = {"resolution": list(resolution), "eevee_samples": eevee_samples, "jitter": bool(jitter),
-           "cycles_shadows": cycles_shadows, "seconds": seconds}
-    for region, mask in masks.items():
-        out[region] = {}
+    regions = _eevee_study_regions(scene_kind, scene, objects, index)
+    out = {"scene": scene_kind, "resolution": list(resolution), "eevee_samples": eevee_samples,
+           "jitter": bool(jitter), "cycles_shadows": cycles_shadows, "seconds": seconds, "regions": {}}
+    for region, mask in regions.items():
+        out["regions"][region] = {}
         for case, (a, c) in {"shadows": ("eevee_shadows", "cycles_shadows"), "no_shadows": ("eevee", "cycles")}.items():
             rel, _ = metrics.rel_values(images[a], images[c], mask, FLOOR_FRACTION)
-            out[region][case] = _stats(rel)
-    # how much the shadows change each engine's floor (the size of what is compared)
-    rel, _ = metrics.rel_values(images["cycles_shadows"], images["cycles"], masks["floor"], FLOOR_FRACTION)
-    out["floor"]["cycles_shadows_vs_cycles"] = _stats(rel)
-    for region in masks:
-        log(f"[eevee shadows] {region}: with shadows median {out[region]['shadows']['median']:.2%} p90 "
-            f"{out[region]['shadows']['p90']:.2%}; without median {out[region]['no_shadows']['median']:.2%} p90 "
-            f"{out[region]['no_shadows']['p90']:.2%}")
+            out["regions"][region][case] = _stats(rel)
+        log(f"[eevee shadows] {scene_kind}, {region}: with shadows median "
+            f"{out['regions'][region]['shadows']['median']:.2%} p90 {out['regions'][region]['shadows']['p90']:.2%}; "
+            f"without median {out['regions'][region]['no_shadows']['median']:.2%}")
+    # how much the shadows change Cycles' render (the size of what is compared)
+    rel, _ = metrics.rel_values(images["cycles_shadows"], images["cycles"], regions["all"], FLOOR_FRACTION)
+    out["cycles_shadows_vs_cycles"] = _stats(rel)
     log(f"[eevee shadows] F12 seconds {seconds}")
     out["images"] = {k: v.astype(np.float32) for k, v in images.items()}
     return out
