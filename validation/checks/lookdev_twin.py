@@ -311,7 +311,7 @@ def checks(result):
     return out
 
 
-def _display(rgb):
+def display(rgb):
     """A preview of a linear render: x / (1 + x), gamma 2.2."""
     x = np.clip(np.nan_to_num(np.asarray(rgb, np.float64)), 0.0, None)
     return np.clip(x / (1.0 + x), 0.0, 1.0) ** (1 / 2.2)
@@ -325,7 +325,7 @@ def write_pictures(result, folder, prefix="lookdev_"):
     paths = []
     for key, image in result["images"].items():
         path = folder / f"{prefix}{key}.png"
-        png.write_rgb(path, _display(image))
+        png.write_rgb(path, display(image))
         paths.append(path)
     return paths
 
