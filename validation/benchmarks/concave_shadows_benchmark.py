@@ -39,6 +39,12 @@ OCCLUDED = {"features": {"occlusion": OCCLUSION}, "light_shadows": None}
 ROWS = (UNSHADOWED, OCCLUDED) + tuple({"features": {"occlusion": OCCLUSION},
                                        "light_shadows": dict(DEFAULT_SHADOWS, samples=n)} for n in SHADOW_SAMPLES)
 QUICK_ROWS = (UNSHADOWED, {"features": {"occlusion": OCCLUSION}, "light_shadows": dict(DEFAULT_SHADOWS)})
+#: The split (full run only): (key, title, ``concave_study`` options, rows): the lights alone and the world alone,
+#: each against its own twin reference, one render per row, no curve.
+SPLIT = (("lights_only", "The studio lights alone (no world)", {"world": False},
+          (UNSHADOWED, {"features": {}, "light_shadows": dict(DEFAULT_SHADOWS)})),
+         ("world_only", "The world alone (the studio lights removed)", {"lights": False},
+          (UNSHADOWED, OCCLUDED)))
 #: (resolution, reference spp, path tracing's curve) of the full run and of ``--quick``.
 FULL = ((256, 192), 64, lookdev_twin.PATH_TRACING_SPP)
 QUICK = ((64, 48), 8, (1, 4))
@@ -110,10 +116,41 @@ def run(args, progress=entry.flush_log):
     result = {"machine": platform.processor() or platform.machine(), "quick": args.quick, "runs": runs,
               "reference": study["reference"], "rows": [_row_record(r, curve) for r in study["rows"]],
               "path_tracing": curve}
+    result["split"] = {} if args.quick else _split(args, resolution, samples, progress)
     if args.out is not None:
         result["picture"] = write_picture(Path(args.out) / "concave_shadows.png", study["rows"]).name
     outputs.write_results(args.out, "concave_shadows", result, to_markdown(result))
     return result
+
+
+def _split(args, resolution, samples, progress):
+    """{key: {"title", "reference", "rows"}} of the lights alone and the world alone (``SPLIT``)."""
+    out = {}
+    for key, title, options, rows in SPLIT:
+        study = lookdev_twin.concave_study(rows, args.lut_dir, resolution, samples, curve_spps=(), runs=1,
+                                           log=progress, **options)
+        out[key] = {"title": title, "reference": study["reference"],
+                    "rows": [_row_record(r, []) for r in study["rows"]]}
+    return out
+
+
+def _split_markdown(split, names):
+    lines = ["## The lights alone and the world alone", "",
+             "The same measurement with the world left out, and with the studio lights removed, each against its own "
+             "twin reference (same size and samples, one render per row): which part of the error the lights' shadows "
+             "and World Occlusion each leave.  \"vs the unshadowed twin\": against the twin with its objects seen by "
+             "camera rays only (the shading's own error, which no shadow removes).", "",
+             "| lighting | World Occlusion | light shadows | all objects | " + " | ".join(_short(n) for n in names) +
+             " | vs the unshadowed twin | reference noise | RT Lit render |",
+             "|---|---|---|---|" + "---|" * len(names) + "---|---|---|"]
+    for part in split.values():
+        for row in part["rows"]:
+            cells = [part["title"], row["features"].get("occlusion", "none"), shadows_label(row["light_shadows"]),
+                     _errors_cell(row["errors"]["all"])] + [_errors_cell(row["errors"].get(n)) for n in names]
+            cells += [_errors_cell(row["unshadowed_twin"]), f"{part['reference']['noise_median']:.1%}",
+                      f"{row['seconds']:.1f} s ({row['rt_lit_samples']} spp)"]
+            lines.append("| " + " | ".join(cells) + " |")
+    return lines + [""]
 
 
 def _short(name):
@@ -172,6 +209,8 @@ def to_markdown(result):
             cells += [_errors_cell(point["errors"].get(n)) for n in names] + [f"{point['seconds']:.1f}"]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
+    if result.get("split"):
+        lines += _split_markdown(result["split"], names)
     if result.get("picture"):
         lines += [f"![RT Lit unshadowed, RT Lit with light shadows at 4 spp + OIDN, path traced]({result['picture']})", ""]
     return "\n".join(lines)

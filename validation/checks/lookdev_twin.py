@@ -441,14 +441,15 @@ def _concave_row(scene, twin, row, reference, runs, log):
 
 
 def concave_study(rows, lut_dir=None, resolution=(256, 192), samples=64, seeds=(0, 1), curve_spps=PATH_TRACING_SPP,
-                  runs=1, log=print):
+                  runs=1, log=print, lights=True, world=True):
     """The concave scene (``lookdev_scene.new_concave_scene``) against its twin, one row per entry of ``rows``
     ({"features": keyword arguments of ``Features``, "light_shadows": None or those of ``shadows.enable_shadows``}):
     each row built afresh (``study_scene``) and its RT Lit render (``runs`` times) measured over every RT Lit
     object's pixels against ONE reference, the twin at ``samples`` spp x ``seeds``, rendered with the first row's
     twin, which also renders path tracing's own curve (``path_tracing_curve``, ``curve_spps``; none when empty).
-    Returns {"reference": its settings, noise and seconds, "rows": [...], "path_tracing": [...]}; each row keeps
-    its images (not JSON)."""
+    ``lights``: False removes the studio lights (the world alone); ``world``: False leaves the world out (the lights
+    alone).  Returns {"reference": its settings, noise and seconds, "rows": [...], "path_tracing": [...]}; each row
+    keeps its images (not JSON)."""
     from ...addon import lookdev_scene
     from ...core.materials.rt_lit_interface import Features
 
@@ -457,8 +458,8 @@ def concave_study(rows, lut_dir=None, resolution=(256, 192), samples=64, seeds=(
         for row in rows:
             features = Features(**row.get("features", {}))
             scene, twin = study_scene(lambda: lookdev_scene.new_concave_scene(
-                "Concave Study", features, view_transform="Standard", lut_dir=lut_dir, resolution=resolution),
-                lut_dir, light_shadows=row.get("light_shadows"))
+                "Concave Study", features, hdri=lookdev_scene.DEFAULT_HDRI if world else None, view_transform="Standard",
+                lut_dir=lut_dir, resolution=resolution), lut_dir, lights, row.get("light_shadows"))
             if reference is None:
                 reference = render_reference(twin, number_objects(scene, twin), resolution, samples, seeds, tmp, log)
                 curve = path_tracing_curve(twin, reference, curve_spps, tmp, runs, log)
