@@ -7,6 +7,10 @@ Blender's own, baked for the World term), an orthographic camera, and render set
 Cycles with 0 bounces (RT Lit surfaces are emitters: with bounces they would light each other a second
 time), the view transform the artist picks (AgX or Standard).
 
+``new_concave_scene(...)`` builds issue 29's asset-like concave scene the same way: a torus resting on the floor of an
+open box and a Suzanne beside it (objects that touch and shadow each other), RT Lit from Principled, the same lights
+and world, a perspective camera (``validation.checks.lookdev_twin.concave_study`` measures it).
+
 ``add_path_traced_twin(scene)`` adds the scene's twin: a scene "<name> Path Traced" with the same world and
 camera that holds every object the scene renders.  An object with an RT Lit material in some slot is copied
 (same data and modifiers, transform copied from the original by a constraint, so moving a sphere moves its

@@ -158,6 +158,13 @@ def _short(name):
     return name.rsplit(" ", 1)[-1]
 
 
+def _seconds_cell(record):
+    """The median seconds of a row or curve point, with the fastest run when there were several (the machine is
+    shared: the fastest is the nearest to the render's own cost)."""
+    runs = record.get("runs") or []
+    return f"{record['seconds']:.1f} s" + (f" (min {min(runs):.1f})" if len(runs) > 1 else "")
+
+
 def _errors_cell(e):
     return f"{e['median']:.1%} / {e['p90']:.1%}" if e and e.get("values") else "-"
 
@@ -174,9 +181,11 @@ def to_markdown(result):
              "once for every row): the per-value relative error where the reference is above 1% of the object's maximum "
              "(the validation's metric), median / p90, over every RT Lit object's pixels and per object.  Light shadows: "
              "the ratio estimator's probe samples per pixel (`enable_shadows(samples=...)`, OIDN on).  RT Lit render: the "
-             f"median of {result['runs']} F12 renders (Cycles on {result['machine'] or 'this machine'}, 2 threads), "
-             "RT Lit samples in brackets (32 with world occlusion: its Ambient Occlusion node traces).  Path tracing at "
-             "equal error: where path tracing's own curve (below) reaches the row's median error (log-log interpolated).",
+             f"median of {result['runs']} F12 renders, wall clock, and the fastest of them (Cycles on "
+             f"{result['machine'] or 'this machine'}, 2 threads, the machine shared with other jobs: the runs spread "
+             "by tens of percent), the RT Lit samples in brackets (32 with world occlusion: its Ambient Occlusion node "
+             "traces).  Path tracing at equal error: where path tracing's own curve (below) reaches the row's median "
+             "error (log-log interpolated, median seconds).",
              ""]
     names = list(objects)
     lines += ["| World Occlusion | light shadows | all objects | " + " | ".join(_short(n) for n in names) +
@@ -186,7 +195,7 @@ def to_markdown(result):
         occlusion = row["features"].get("occlusion", "none")
         cells = [occlusion, shadows_label(row["light_shadows"]), _errors_cell(row["errors"]["all"])]
         cells += [_errors_cell(row["errors"].get(n)) for n in names]
-        cells += [f"{row['seconds']:.1f} s ({row['rt_lit_samples']} spp)",
+        cells += [f"{_seconds_cell(row)}, {row['rt_lit_samples']} spp",
                   _equal_error_cell(result["path_tracing"], row["errors"]["all"]["median"])]
         lines.append("| " + " | ".join(cells) + " |")
     plain = next((r for r in result["rows"] if r["light_shadows"] is None and not r["features"]), None)
@@ -202,11 +211,11 @@ def to_markdown(result):
                   f"The twin at n spp (one seed, not the reference's) against the same reference, median of "
                   f"{result['runs']} renders' seconds.  Its error includes the reference's noise "
                   f"({ref['noise_median']:.1%}), so it flattens as n nears the reference's {ref['samples']} spp.", "",
-                  "| spp | all objects | " + " | ".join(_short(n) for n in names) + " | seconds |",
+                  "| spp | all objects | " + " | ".join(_short(n) for n in names) + " | path tracing render |",
                   "|---|---|" + "---|" * len(names) + "---|"]
         for point in result["path_tracing"]:
             cells = [str(point["spp"]), _errors_cell(point["errors"]["all"])]
-            cells += [_errors_cell(point["errors"].get(n)) for n in names] + [f"{point['seconds']:.1f}"]
+            cells += [_errors_cell(point["errors"].get(n)) for n in names] + [_seconds_cell(point)]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     if result.get("split"):
