@@ -38,8 +38,9 @@ class RTL_OT_new_lookdev_scene(bpy.types.Operator):
     floor: BoolProperty(name="Floor", default=False,
                         description="A grey RT Lit floor under the spheres (shadowed with Shadows on)")
     shadows: BoolProperty(name="Shadows", default=False,
-                          description="World occlusion on every RT Lit material, and the lights' shadows in Cycles "
-                                      "renders (F12; EEVEE and the viewport stay unshadowed)")
+                          description="The lights' and the world's shadows in Cycles renders (F12), and World "
+                                      "Occlusion on every RT Lit material for EEVEE and the viewport (their lights "
+                                      "stay unshadowed)")
     specular: EnumProperty(name="Specular", items=SPECULAR_ITEMS, default=Features().specular)
     diffuse: EnumProperty(name="Diffuse", items=DIFFUSE_ITEMS, default=Features().diffuse)
 

@@ -15,6 +15,8 @@
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import bpy
 import numpy as np
 
@@ -290,6 +292,16 @@ ENGINE_TREES = (("Cycles", "CYCLES", "linear", ""), ("EEVEE", "EEVEE", "fetch4",
 #: "Uniform block _node_tree too big (66000/65536)" and a wrong image in tests/blender/test_engine_trees.py).
 AOV_ENGINES = ("Cycles",)
 ENGINE_STAMP_KEY = "rtl_engine_trees"
+#: With the World term's shadows on as well (addon/shadows.py, ``world=True``): the Cycles tree writes the World
+#: Radiance part and the world's white-Lambert radiance (SH) to these Shader AOVs (function output -> AOV), and leaves
+#: out ``Features.occlusion`` (the ratio occludes the world there).
+WORLD_AOVS = {"World Radiance": "RTL World", "World Irradiance": "RTL World Irradiance"}
+
+
+def world_shadows_on(scene):
+    """Whether ``scene``'s RT Lit shadows shadow the World term too (``shadows.enable_shadows(world=True)``)."""
+    stored = scene.get(SHADOWS_KEY)
+    return stored is not None and bool(stored.get("world", False))
 
 
 def engine_tree_name(features, engine):
@@ -326,8 +338,11 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
     tables = _tables(lut_dir, env)
     trees, material_inputs = {}, None
     for engine, _, table_filter_mode, _ in ENGINE_TREES:
+        aovs = engine in AOV_ENGINES and SHADOWS_KEY in scene
+        world_aovs = aovs and env is not None and world_shadows_on(scene)
         with table_filter(table_filter_mode):
-            material = rt_lit.build_rt_lit(features, tuple(records[i][1] for i in shaded), env)
+            material = rt_lit.build_rt_lit(replace(features, occlusion="none") if world_aovs else features,
+                                           tuple(records[i][1] for i in shaded), env, world_irradiance=world_aovs)
         inputs = _TreeInputs()
         internal = {n: inputs.geometry(_GEOMETRY_SOCKETS[n]) for n in GEOMETRY_INPUTS}
         # the material function's light k is the scene's light shaded[k]: "Light k p" <- "Light shaded[k] p"; the
@@ -345,9 +360,10 @@ def ensure_rt_lit_group(features=None, scene=None, lut_dir=None, lights=None):
                                                  stamp_extra=repr((records, shaded, world_record and world_record["table"],
                                                                    sorted(linked.items()))),
                                                  tables=tables, shader_sums={"Shader": list(material.part_outputs)},
-                                                 aov_outputs=({part: light_aov_name(shaded[k]) for k, part
-                                                               in enumerate(material.part_outputs[1:1 + len(shaded)])}
-                                                              if engine in AOV_ENGINES and SHADOWS_KEY in scene else None))
+                                                 aov_outputs=({**{part: light_aov_name(shaded[k]) for k, part
+                                                                  in enumerate(material.part_outputs[1:1 + len(shaded)])},
+                                                               **(WORLD_AOVS if world_aovs else {})}
+                                                              if aovs else None))
         material_inputs = material.material_inputs
     ng = _ensure_engine_group(name, trees, material_inputs)
     ng[FEATURES_KEY] = features.as_dict()
@@ -373,7 +389,10 @@ def _ensure_engine_group(name, trees, material_inputs):
     ng = bpy.data.node_groups.get(name)
     if ng is None:
         ng = bpy.data.node_groups.new(name, "ShaderNodeTree")
-    stamp = repr([(engine, tree.name) for engine, tree in trees.items()] + list(material_inputs))
+    # a tree's outputs in the stamp: a tree rebuilt with another output list (the World shadows' "World Irradiance")
+    # loses the links of this group's node to it
+    stamp = repr([(engine, tree.name, [i.name for i in tree.interface.items_tree if getattr(i, "in_out", "") == "OUTPUT"])
+                  for engine, tree in trees.items()] + list(material_inputs))
     wanted = [(engine_output(engine, out), "OUTPUT", RT_LIT_OUTPUTS[out].kind, RT_LIT_OUTPUTS[out])
               for engine in trees for out in RT_LIT_OUTPUTS]
     wanted += [(n, "INPUT", RT_LIT_INPUTS[n].kind, RT_LIT_INPUTS[n]) for n in material_inputs]

@@ -174,8 +174,9 @@ class RTL_OT_sync_lights(bpy.types.Operator):
 
 
 class RTL_OT_enable_shadows(bpy.types.Operator):
-    """Shadow the RT Lit lights in Cycles renders (F12): each light's RT Lit term scaled by a denoised ratio of
-    path-traced shadowed and unshadowed light (Heitz et al. 2018), from two probe view layers and a compositor"""
+    """Shadow the RT Lit lights (and the world) in Cycles renders (F12): each light's RT Lit term scaled by a denoised
+    ratio of path-traced shadowed and unshadowed light (Heitz et al. 2018), from two probe view layers and a
+    compositor"""
 
     bl_idname = "rtl.enable_shadows"
     bl_label = "Enable RT Lit Shadows"
@@ -185,6 +186,10 @@ class RTL_OT_enable_shadows(bpy.types.Operator):
                                    description="Samples of the probe view layers: more is less noise, more time")
     denoise: bpy.props.BoolProperty(name="Denoise", default=True,
                                     description="Denoise the shadowed and unshadowed estimates (Open Image Denoise)")
+    world: bpy.props.BoolProperty(name="Shadow the World", default=True,
+                                  description="The world's light occluded too, by its path-traced light on a white "
+                                              "probe over RT Lit's own: in Cycles the world's diffuse light becomes "
+                                              "the path-traced one (no longer the SH of EEVEE and engines)")
 
     @classmethod
     def poll(cls, context):
@@ -200,12 +205,13 @@ class RTL_OT_enable_shadows(bpy.types.Operator):
 
         try:               # all or nothing: a refused enable changes nothing (shadows.enable_shadows)
             shadows.enable_shadows(context.scene, self.samples, self.denoise,
-                                   lut_dir=preferences.lut_directory(context))
+                                   lut_dir=preferences.lut_directory(context), world=self.world)
         except shadows.ShadowError as ex:
             self.report({'ERROR'}, str(ex))
             return {'CANCELLED'}
         lights = len(shadows.shadowed_lights(context.scene))
-        self.report({'INFO'}, f"RT Lit shadows on: {lights} lights, {self.samples} shadow samples"
+        world = " and the world" if shadows.shadow_settings(context.scene)["world"] else ""
+        self.report({'INFO'}, f"RT Lit shadows on: {lights} lights{world}, {self.samples} shadow samples"
                               f"{', denoised' if self.denoise else ''} (Cycles F12 renders; EEVEE and the viewport "
                               "stay unshadowed)")
         return {'FINISHED'}
@@ -314,7 +320,7 @@ class RTL_OT_sync_world(ModalTask, bpy.types.Operator):
         return _scene_exists(cls, context)
 
     def execute(self, context):
-        from . import materials
+        from . import materials, shadows
         from . import world_sync as world
 
         scene = context.scene
@@ -335,6 +341,7 @@ class RTL_OT_sync_world(ModalTask, bpy.types.Operator):
         def finish(bake):
             try:
                 record = world.sync_world(scene, bake=bake)
+                shadows.refresh_shadows(scene, lut_dir)      # the World term's shadows follow the synced world
                 groups = materials.rebuild_rt_lit_groups(scene, lut_dir)
                 world.remove_stale_environment_images(keep=record and record["table"])
             except Exception as ex:

@@ -31,6 +31,19 @@ divide").  Here, in one F12 render (``bpy.ops.render.render``), measured by the 
   ``ratio_i = clamp((S_i + eps) / (U_i + eps), 0, 1)`` (``EPSILON``): where U_i is about 0 (the light below the
   horizon or outside its cone) the ratio falls back to 1, and a denoised S above U counts as unshadowed.
 
+The World term (``world=True``, the default) takes the same idea with an analytic denominator: the scene's world
+(``World.lightgroup`` = ``WORLD_LIGHT_GROUP``, declared in layer S only) lights the white probe, path traced, and the
+RT Lit Cycles tree writes the World term's radiance ("RTL World") and the world's white-Lambert radiance as RT Lit
+computes it, E_SH(N) / pi x Strength ("RTL World Irradiance": ``world_shading.world_irradiance``):
+
+    final += AOV_world * (ratio_world - 1),  ratio_world = min((max(S_world, 0) + eps) / (max(E, 0) + eps), 4).
+
+There is no U for the world (Cycles cannot light a probe by the world unoccluded), so the noise of S_world is not
+cancelled (OIDN takes it) and the ratio is visibility times Cycles' irradiance over SH's: in Cycles, the world's light
+on RT Lit surfaces is the path-traced irradiance (as an engine's ray-traced ambient occlusion and diffuse GI replace
+its probe), no longer the L2 SH's, and its specular is scaled by the same (diffuse) ratio.  EEVEE and the shader
+backend keep the SH and ``Features.occlusion``.  Measured in docs/shadows.md (the floor study, the spheres).
+
 A scene that already has a compositor is refused (``ShadowError``): this module does not edit a graph it did not
 make.  The AOV nodes are in the RT Lit Cycles trees only while shadows are on (the groups are rebuilt on enable and
 disable): EEVEE compiles an AOV node's inputs whatever the Material Output's target (``materials.AOV_ENGINES``), so
@@ -44,7 +57,7 @@ from pathlib import Path
 
 import bpy
 
-from . import compat, materials, preferences
+from . import compat, materials, preferences, world_sync
 from .common import SHADOW_COPY_KEY, SHADOWS_KEY, light_aov_name, node_groups_kept_on_error
 
 #: The probe view layers: (role, view layer name, collection of the light copies, light-group prefix, shadowed).
@@ -56,6 +69,13 @@ PROBE_MATERIAL = "RTL Shadow Probe"
 COMPOSITOR_NAME = "RTL Shadows"
 #: Added to S and U before the division: the ratio is 1 where both are 0.
 EPSILON = 1e-6
+#: The World term's shadows (``world=True``): the world's light group in probe layer S, and the guards of the ratio
+#: S_world / E: (max(S, 0) + eps) / (max(E, 0) + eps), at most WORLD_RATIO_MAX.  E (the AOV
+#: ``materials.WORLD_AOVS["World Irradiance"]``) is RT Lit's own SH irradiance, not an estimate from the same samples
+#: as S: the ratio carries SH's error as well as the visibility (above 1 where SH is too dark; module docstring).
+WORLD_LIGHT_GROUP = "s_world"
+WORLD_EPSILON = 1e-4
+WORLD_RATIO_MAX = 4.0
 #: Light data properties of the copies driven from the original's (those the light has).
 DRIVEN_PROPERTIES = ("energy", "shadow_soft_size", "size", "size_y", "spot_size", "spot_blend", "angle", "spread")
 
@@ -70,12 +90,13 @@ def shadows_enabled(scene):
 
 
 def shadow_settings(scene):
-    """{"samples", "denoise", "beauty"} of a scene with shadows on, or None."""
+    """{"samples", "denoise", "beauty", "world"} of a scene with shadows on, or None."""
     stored = scene.get(SHADOWS_KEY)
     if stored is None:
         return None
     stored = stored.to_dict() if hasattr(stored, "to_dict") else dict(stored)
-    return {"samples": int(stored["samples"]), "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"])}
+    return {"samples": int(stored["samples"]), "denoise": bool(stored["denoise"]), "beauty": str(stored["beauty"]),
+            "world": bool(stored.get("world", False))}
 
 
 def shadowed_lights(scene):
@@ -89,20 +110,22 @@ def light_group_name(role, index):
     return f"{prefix}{index}"
 
 
-def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None):
+def enable_shadows(scene, samples=4, denoise=True, view_layer=None, lut_dir=None, world=True):
     """Shadow RT Lit materials in ``scene``'s Cycles renders (Heitz et al. 2018's ratio estimator; module docstring).
 
     ``samples``: the probe layers' samples per pixel; ``denoise``: Open Image Denoise on each S and U pass;
     ``view_layer``: the name of the view layer whose render is shadowed (default: the first one that renders).
-    The lights are those of the last light sync (``materials.synced_light_kinds``, the AOVs' indices).  The RT Lit
-    groups are rebuilt with the lights' AOVs in their Cycles trees (``materials.AOV_ENGINES``; ``lut_dir``: the
-    tables, default the preferences').  Enabling again rebuilds everything (the same result).  Raises ``ShadowError``
-    (changing nothing) when the scene renders with another engine, has no synced light, or has a compositor of its
-    own."""
-    _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups=True)
+    The lights are those of the last light sync (``materials.synced_light_kinds``, the AOVs' indices).  ``world``:
+    shadow the World term too (when the scene has a world and RT Lit a World term; its part of the module docstring): the Cycles trees then
+    leave out ``Features.occlusion`` (the ratio is the world's occlusion there).  The RT Lit groups are rebuilt with
+    the AOVs in their Cycles trees (``materials.AOV_ENGINES``; ``lut_dir``: the tables, default the preferences').
+    Enabling again rebuilds everything (the same result).  Raises ``ShadowError`` (changing nothing) when the scene
+    renders with another engine, has nothing to shadow (no synced light, and no world or ``world`` False), or has a
+    compositor of its own."""
+    _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups=True, world=world)
 
 
-def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups):
+def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups, world):
     settings = shadow_settings(scene)
     if scene.render.engine != "CYCLES":
         raise ShadowError(f"RT Lit shadows need Cycles (the scene renders with {scene.render.engine})")
@@ -110,16 +133,19 @@ def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups):
     if tree is not None and not tree.get(SHADOWS_KEY):
         raise ShadowError("The scene has a compositor of its own; RT Lit shadows build theirs and do not edit another "
                           "one: remove it (or its nodes) first")
-    lights = _synced_lights(scene)
+    requested, world = bool(world), bool(world) and scene.world is not None and world_sync.world_synced()
+    lights = _synced_lights(scene, allow_none=world)
     beauty = _beauty_layer(scene, view_layer or (settings["beauty"] if settings is not None else None))
     use_compositing = bool(scene[SHADOWS_KEY]["use_compositing"]) if settings is not None \
         else bool(scene.render.use_compositing)
     if settings is not None:
         _remove_parts(scene)
     scene[SHADOWS_KEY] = {"samples": int(samples), "denoise": bool(denoise), "beauty": beauty.name,
-                          "use_compositing": use_compositing, "aovs": []}
+                          "use_compositing": use_compositing, "aovs": [], "world": world, "world_requested": requested}
+    if world:
+        scene[SHADOWS_KEY]["world_lightgroup"] = str(scene.world.lightgroup)
     try:
-        _build(scene, beauty, lights, int(samples), bool(denoise))
+        _build(scene, beauty, lights, int(samples), bool(denoise), world)
         if rebuild_groups:              # the AOVs in the RT Lit Cycles trees (kept when they are there)
             _rebuild_groups(scene, lut_dir)
     except BaseException:
@@ -128,12 +154,15 @@ def _enable(scene, samples, denoise, view_layer, lut_dir, rebuild_groups):
 
 
 def refresh_shadows(scene, lut_dir=None):
-    """After a light sync (which built the RT Lit groups with the AOVs): rebuild the light copies and the compositor
-    for the synced lights when shadows are on; returns whether it did."""
+    """After a light sync (which built the RT Lit groups with the AOVs) or a world sync (before the groups are
+    rebuilt): rebuild the light copies and the compositor for the synced lights and world when shadows are on;
+    returns whether it did."""
     settings = shadow_settings(scene)
     if settings is None:
         return False
-    _enable(scene, settings["samples"], settings["denoise"], settings["beauty"], lut_dir, rebuild_groups=False)
+    requested = bool(scene[SHADOWS_KEY].get("world_requested", settings["world"]))
+    _enable(scene, settings["samples"], settings["denoise"], settings["beauty"], lut_dir, rebuild_groups=False,
+            world=requested)
     return True
 
 
@@ -169,6 +198,8 @@ def _remove_parts(scene):
         del tree[SHADOWS_KEY]
         compat.remove_compositor(scene, tree)
     scene.render.use_compositing = bool(stored.get("use_compositing", True))
+    if "world_lightgroup" in stored and scene.world is not None:
+        scene.world.lightgroup = str(stored["world_lightgroup"])
     beauty = scene.view_layers.get(str(stored.get("beauty", "")))
     if beauty is not None:
         for name in list(stored.get("aovs", [])):
@@ -201,21 +232,22 @@ def _beauty_layer(scene, name):
     return layer
 
 
-def _synced_lights(scene):
+def _synced_lights(scene, allow_none=False):
     """[(scene light index, object)] of the last light sync (the indices of the RT Lit trees' AOVs)."""
     out = []
     for index, (name, _) in enumerate(materials.synced_light_kinds()):
         obj = scene.objects.get(name)
         if obj is not None and obj.type == "LIGHT":
             out.append((index, obj))
-    if not out:
+    if not out and not allow_none:
         raise ShadowError("No light is synced with the RT Lit materials: run Sync Lights first")
     return out
 
 
-def _build(scene, beauty, lights, samples, denoise):
+def _build(scene, beauty, lights, samples, denoise, world):
     stored = scene[SHADOWS_KEY]
-    added = [light_aov_name(index) for index, _ in lights if beauty.aovs.get(light_aov_name(index)) is None]
+    names = [light_aov_name(index) for index, _ in lights] + (list(materials.WORLD_AOVS.values()) if world else [])
+    added = [name for name in names if beauty.aovs.get(name) is None]
     for name in added:
         aov = beauty.aovs.add()
         aov.name = name
@@ -251,9 +283,13 @@ def _build(scene, beauty, lights, samples, denoise):
                 child.exclude = True
         for index, _ in lights:
             layer.lightgroups.add(name=light_group_name(role, index))
+        if world and role == "S":
+            layer.lightgroups.add(name=WORLD_LIGHT_GROUP)
+    if world:
+        scene.world.lightgroup = WORLD_LIGHT_GROUP
     scene.render.use_compositing = True
     scene.render.use_single_layer = False
-    _build_compositor(scene, beauty, layers, [index for index, _ in lights], denoise)
+    _build_compositor(scene, beauty, layers, [index for index, _ in lights], denoise, world)
 
 
 def _root_collection(layer):
@@ -344,9 +380,10 @@ def _drive(data, prop, source, path, index=-1):
     var.targets[0].data_path = path
 
 
-def _build_compositor(scene, beauty, layers, indices, denoise):
-    """final = beauty + sum_i AOV_i * (clamp((S_i + eps) / (U_i + eps), 0, 1) - 1), each S_i, U_i denoised when
-    ``denoise``; written as beauty - AOV_i + AOV_i * ratio_i, so the result keeps the beauty's alpha."""
+def _build_compositor(scene, beauty, layers, indices, denoise, world):
+    """final = beauty + sum_i AOV_i * (clamp((S_i + eps) / (U_i + eps), 0, 1) - 1) (+ the World term's
+    AOV_world * (ratio_world - 1) with ``world``), each S_i, U_i (S_world) denoised when ``denoise``; written as
+    beauty - AOV + AOV * ratio, so the result keeps the beauty's alpha."""
     tree, result = compat.new_compositor(scene, COMPOSITOR_NAME)
     tree[SHADOWS_KEY] = True
     render = {}
@@ -366,6 +403,20 @@ def _build_compositor(scene, beauty, layers, indices, denoise):
             parts[role] = compat.mix_colors(tree, socket, (EPSILON,) * 3, "ADD")
         ratio = compat.mix_colors(tree, parts["S"], parts["U"], "DIVIDE", clamp=True)
         aov = render["beauty"].outputs[light_aov_name(index)]
+        image = compat.mix_colors(tree, image, aov, "SUBTRACT")
+        image = compat.mix_colors(tree, image, compat.mix_colors(tree, aov, ratio, "MULTIPLY"), "ADD")
+    if world:       # the World term: AOV_world * (S_world / E - 1), guarded (WORLD_EPSILON, WORLD_RATIO_MAX)
+        socket = render["S"].outputs[f"Combined_{WORLD_LIGHT_GROUP}"]
+        if denoise:
+            socket = compat.new_denoise(tree, socket)
+        s_world = compat.mix_colors(tree, compat.mix_colors(tree, socket, (0.0,) * 3, "LIGHTEN"),
+                                    (WORLD_EPSILON,) * 3, "ADD")
+        irradiance = render["beauty"].outputs[materials.WORLD_AOVS["World Irradiance"]]
+        e_world = compat.mix_colors(tree, compat.mix_colors(tree, irradiance, (0.0,) * 3, "LIGHTEN"),
+                                    (WORLD_EPSILON,) * 3, "ADD")
+        ratio = compat.mix_colors(tree, compat.mix_colors(tree, s_world, e_world, "DIVIDE"),
+                                  (WORLD_RATIO_MAX,) * 3, "DARKEN")
+        aov = render["beauty"].outputs[materials.WORLD_AOVS["World Radiance"]]
         image = compat.mix_colors(tree, image, aov, "SUBTRACT")
         image = compat.mix_colors(tree, image, compat.mix_colors(tree, aov, ratio, "MULTIPLY"), "ADD")
     tree.links.new(image, result)

@@ -40,8 +40,9 @@ def draw_shadows(layout, scene):
         return
     box.label(text=f"Shadows: {settings['samples']} samples{', denoised' if settings['denoise'] else ''}",
               icon='CHECKMARK')
-    box.label(text="Cycles F12: shadowed (ratio estimator)", icon='BLANK1')
-    box.label(text="EEVEE, viewport: unshadowed", icon='BLANK1')
+    box.label(text="Cycles F12: lights " + ("and world shadowed" if settings["world"] else "shadowed")
+              + " (ratio estimator)", icon='BLANK1')
+    box.label(text="EEVEE, viewport: lights unshadowed", icon='BLANK1')
     box.operator("rtl.disable_shadows", icon='X')
 
 

@@ -395,6 +395,12 @@ def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
     return record
 
 
+def world_synced():
+    """Whether RT Lit has a World term (a synced world: "RTL World" with its record), without loading it."""
+    ng = bpy.data.node_groups.get(WORLD_GROUP)
+    return ng is not None and bool(ng.get(RECORD_KEY))
+
+
 def world_environment():
     """(WorldEnvironment, record) of the synced world, or None when "RTL World" is absent.  The
     environment is read from the bake's cache file, or from the image packed in this .blend when the

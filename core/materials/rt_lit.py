@@ -44,12 +44,18 @@ from .rt_lit_interface import (EMISSION_OUTPUT, GEOMETRY_INPUTS, LIGHT_KINDS, OC
 from .surface import SURFACE
 
 
+#: Extra output of the material function built with ``world_irradiance=True`` (not a part of the radiance): the
+#: world's white-Lambert radiance E_SH(N) / pi x Strength, the denominator of the World term's ratio estimator
+#: (addon/shadows.py, ``world=True``).
+WORLD_IRRADIANCE_OUTPUT = "World Irradiance"
+
+
 def light_parameters(kind):
     """The driver parameters of one light of ``kind`` ("Location X", ..., "Power", ...), in order."""
     return [n for n in lights.light_data(kind).input_sockets if n not in lights.SHADING_POINT_INPUTS]
 
 
-def compose(tables, features, material, geometry, lights_in_scene, world=None):
+def compose(tables, features, material, geometry, lights_in_scene, world=None, extras=None):
     """[the material's emission, radiance from light 0, from light 1, ..., (the world)]: the terms of
     the material's radiance (in nodes, one Emission closure each); the world's term comes last.
 
@@ -57,7 +63,9 @@ def compose(tables, features, material, geometry, lights_in_scene, world=None):
     ``lights_in_scene``: [(kind, {parameter -> value})]; ``world``: None or (``WorldEnvironment``,
     {``WORLD_PARAMETERS`` name -> value}); with ``features.occlusion`` on, ``geometry`` also holds the
     renderer's ambient occlusion (``OCCLUSION_INPUT``).  Values are arrays (``tables`` holding data, the
-    environment's table included) or Exprs (``tables`` = ``REFERENCES``)."""
+    environment's table included) or Exprs (``tables`` = ``REFERENCES``).  ``extras``: None, or a dict that
+    receives ``WORLD_IRRADIANCE_OUTPUT`` (the world's white-Lambert radiance, not a part of the sum) when there
+    is a world."""
     surface = SURFACE(**{k: material[k] for k in RT_LIT_INPUTS},
                       **{k: geometry[k] for k in ("Geometry Normal", "Incoming")})
     parts = [surface["Emission"]]
@@ -65,6 +73,8 @@ def compose(tables, features, material, geometry, lights_in_scene, world=None):
     if world is not None:
         env, params = world
         parts.append(world_shading.shade_world(tables, features, env, surface, params, geometry.get(OCCLUSION_INPUT)))
+        if extras is not None:
+            extras[WORLD_IRRADIANCE_OUTPUT] = world_shading.world_irradiance(surface, params)
     return parts
 
 
@@ -223,10 +233,12 @@ def _function_inputs(features, light_kinds, environment):
     return kinds, sockets, tuple(per_light), world, occlusion
 
 
-def build_rt_lit(features=Features(), light_kinds=(), environment=None):
+def build_rt_lit(features=Features(), light_kinds=(), environment=None, world_irradiance=False):
     """The whole RT Lit material traced for ``features``, the light kinds in order and the world's
-    ``WorldEnvironment`` (None: no World term, nothing of it built).  Cached (per folding setting)."""
-    return _build(features, tuple(light_kinds), environment, folding_enabled(), table_filter_mode())
+    ``WorldEnvironment`` (None: no World term, nothing of it built).  ``world_irradiance``: with a world, one more
+    output ``WORLD_IRRADIANCE_OUTPUT`` (the World shadows' denominator).  Cached (per folding setting)."""
+    return _build(features, tuple(light_kinds), environment, folding_enabled(), table_filter_mode(),
+                  bool(world_irradiance and environment is not None))
 
 
 def op_counts(features, light_kinds=(), environment=None):
@@ -239,7 +251,7 @@ def op_counts(features, light_kinds=(), environment=None):
 
 
 @functools.lru_cache(maxsize=32)
-def _build(features, light_kinds, environment, folded, table_filter):
+def _build(features, light_kinds, environment, folded, table_filter, world_irradiance=False):
     kinds, sockets, per_light, world, occlusion = _function_inputs(features, light_kinds, environment)
     part_names = [EMISSION_OUTPUT] + [light_output(i) for i in range(len(light_kinds))]
     if environment is not None:
@@ -250,16 +262,19 @@ def _build(features, light_kinds, environment, folded, table_filter):
         geometry = {k: kw[k] for k in (*GEOMETRY_INPUTS, *occlusion)}
         in_scene = [(kind, {p: kw[n] for p, n in names.items()}) for kind, names in zip(light_kinds, per_light)]
         world_in = (environment, {p: kw[n] for p, n in world.items()}) if environment is not None else None
-        parts = compose(REFERENCES, features, material, geometry, in_scene, world_in)
+        extras = {} if world_irradiance else None
+        parts = compose(REFERENCES, features, material, geometry, in_scene, world_in, extras)
         total = parts[0]
         for part in parts[1:]:
             total = total + part
-        return {RADIANCE_OUTPUT: total, **dict(zip(part_names, parts))}
+        return {RADIANCE_OUTPUT: total, **dict(zip(part_names, parts)), **(extras or {})}
 
     out_sockets = {RADIANCE_OUTPUT: RT_LIT_OUTPUTS[RADIANCE_OUTPUT]}
     out_sockets.update({n: color((0.0, 0.0, 0.0), f"{n} towards the viewer") for n in part_names})
+    if world_irradiance:
+        out_sockets[WORLD_IRRADIANCE_OUTPUT] = color((0.0, 0.0, 0.0), "The world's white-Lambert radiance (SH)")
     env_label = f"; {environment.name}" if environment is not None else ""
-    name = f"RT Lit ({features.label()}; {len(light_kinds)} lights{env_label})"
+    name = f"RT Lit ({features.label()}; {len(light_kinds)} lights{env_label}{'; irradiance' if world_irradiance else ''})"
     function = define(name, body, kinds, f"RT Lit lookdev material ({features.label()})", (sockets, out_sockets))
     return RtLitMaterial(features, light_kinds, environment, function, tuple(RT_LIT_INPUTS), tuple(GEOMETRY_INPUTS),
                          per_light, world, tuple(part_names), occlusion)

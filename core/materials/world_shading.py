@@ -501,6 +501,15 @@ def world_radiance(tables, features, env, surface, params, ambient_occlusion=Non
     return op.scale(total, params["Strength"])
 
 
+def world_irradiance(surface, params):
+    """The world's white-Lambert radiance E_SH(N) / pi x Strength (3-vector): the analytic, unshadowed denominator
+    of the World term's ratio estimator (addon/shadows.py, ``world=True``), for the same shading normal as the
+    diffuse; ``surface`` needs "N" (and the world's "Rotation")."""
+    rotated = WORLD_ROTATION(N=surface["N"], V=surface["N"], Rotation=params["Rotation"])
+    coeffs = [params[name] for name in SH_NAMES]
+    return op.scale(sh_lobe(coeffs, rotated["N"], indirect.COSINE_LOBE_ZONAL), params["Strength"])
+
+
 def _occlusion_factors(features, surface, roughness, ambient_occlusion):
     """(occlusion of the broad lobes, of the GGX specular) for ``features.occlusion``; (None, None) when off.
 

@@ -309,10 +309,92 @@ def test_operators_turn_shadows_on_and_off_and_the_twin_leaves_the_copies_out(re
     assert not bpy.ops.rtl.enable_shadows.poll()
     scene.render.engine = engine
     assert bpy.ops.rtl.enable_shadows(samples=2, denoise=False) == {'FINISHED'}
-    assert shadows.shadow_settings(scene) == {"samples": 2, "denoise": False, "beauty": "ViewLayer"}
+    assert shadows.shadow_settings(scene) == {"samples": 2, "denoise": False, "beauty": "ViewLayer", "world": False}
     assert shadows.shadowed_lights(scene) == [0]
     twin = lookdev_scene.add_path_traced_twin(scene)
     assert not [o.name for o in twin.objects if SHADOW_COPY_KEY in o]
     assert [o.name for o in twin.objects if o.type == "LIGHT"] == ["Key"]
     assert bpy.ops.rtl.disable_shadows() == {'FINISHED'}
     assert not shadows.shadows_enabled(scene) and not bpy.ops.rtl.disable_shadows.poll()
+
+
+def test_world_shadows_darken_the_floor_and_disable_restores(empty_scene, lut_dir, tmp_path):
+    """``enable_shadows(world=True)`` on the floor study lit by the world alone: the beauty still renders (a tree
+    rebuilt with the "World Irradiance" output once unlinked the Cycles Shader of the RT Lit group: a black beauty),
+    the floor gets darker (the spheres' shadows and SH's too bright zenith irradiance: docs/shadows.md), and disable
+    puts the world's light group and the trees back (the render bit-identical); a saved file re-opens with the world
+    shadowed (the same render)."""
+    import bpy
+
+    from rt_lookdev.addon import light_sync, lookdev_scene, materials, shadows
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+    from rt_lookdev.validation.checks import lookdev_twin
+
+    scene = lookdev_scene.new_lookdev_scene("WR", Features(), view_transform="Standard", lut_dir=lut_dir, floor=True)
+    for obj in [o for o in scene.objects if o.type == "LIGHT"]:
+        bpy.data.objects.remove(obj)
+    light_sync.sync_lights(scene, lut_dir)
+    floor = scene.objects["WR Floor"]
+    for i, obj in enumerate(lookdev_scene.lookdev_spheres(scene), start=1):
+        obj.pass_index = i
+    res = (48, 30)
+    plain, index, _ = lookdev_twin.render_measurement(scene, res, 1, 0, tmp_path)
+    with pytest.raises(shadows.ShadowError):
+        shadows.enable_shadows(scene, lut_dir=lut_dir, world=False)     # no light, the world not asked: nothing to do
+    assert not shadows.shadows_enabled(scene)
+    shadows.enable_shadows(scene, samples=4, denoise=False, lut_dir=lut_dir)
+    assert shadows.shadow_settings(scene)["world"] is True
+    assert scene.world.lightgroup == shadows.WORLD_LIGHT_GROUP
+    shaded, index_s, _ = lookdev_twin.render_measurement(scene, res, 1, 0, tmp_path)
+    on_floor = (index == floor.pass_index) & (index_s == floor.pass_index)
+    assert on_floor.sum() > 100
+    assert np.all(np.isfinite(shaded))
+    ratio = shaded[on_floor].mean(-1) / plain[on_floor].mean(-1)
+    print(f"floor ratio p10/p50/p90 {np.percentile(ratio, [10, 50, 90])}")
+    assert 0.4 < np.median(ratio) < 0.95
+    blend = tmp_path / "world_shadows.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    scene = bpy.data.scenes["WR"]
+    reloaded, _, _ = lookdev_twin.render_measurement(scene, res, 1, 0, tmp_path)
+    np.testing.assert_allclose(reloaded, shaded, rtol=1e-5, atol=1e-6)
+    shadows.disable_shadows(scene, lut_dir)
+    assert scene.world.lightgroup == ""
+    for ng in bpy.data.node_groups:
+        if ng.name.endswith("[Cycles]"):
+            assert "World Irradiance" not in [i.name for i in ng.interface.items_tree]
+    again, index_d, _ = lookdev_twin.render_measurement(scene, res, 1, 0, tmp_path)
+    np.testing.assert_allclose(again, plain, rtol=1e-5, atol=1e-6)
+    assert materials.world_shadows_on(scene) is False
+
+
+def _ao_nodes(tree):
+    return [n for n in tree.nodes if n.bl_idname == "ShaderNodeAmbientOcclusion"]
+
+
+def test_world_shadows_take_the_place_of_world_occlusion_in_cycles_only(empty_scene, lut_dir):
+    """With the world shadowed, the Cycles trees drop ``Features.occlusion`` (the ratio occludes the world: AO as
+    well would occlude it twice), EEVEE's keep it; without the world option, and after disable, Cycles' AO is back."""
+    import bpy
+
+    from rt_lookdev.addon import lookdev_scene, shadows
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    scene = lookdev_scene.new_lookdev_scene("AO", Features(occlusion="cones_clipped"), view_transform="Standard",
+                                            lut_dir=lut_dir, resolution=(32, 16))
+
+    def trees(engine):
+        found = [ng for ng in bpy.data.node_groups if ng.name.startswith("RT Lit (") and ng.name.endswith(f"[{engine}]")]
+        assert found
+        return found
+
+    assert all(_ao_nodes(t) for t in trees("Cycles")) and all(_ao_nodes(t) for t in trees("EEVEE"))
+    shadows.enable_shadows(scene, samples=1, denoise=False, lut_dir=lut_dir)
+    assert shadows.shadow_settings(scene)["world"] is True
+    assert not any(_ao_nodes(t) for t in trees("Cycles")) and all(_ao_nodes(t) for t in trees("EEVEE"))
+    shadows.enable_shadows(scene, samples=1, denoise=False, lut_dir=lut_dir, world=False)
+    assert shadows.shadow_settings(scene)["world"] is False and scene.world.lightgroup == ""
+    assert all(_ao_nodes(t) for t in trees("Cycles"))
+    shadows.enable_shadows(scene, samples=1, denoise=False, lut_dir=lut_dir)
+    shadows.disable_shadows(scene, lut_dir)
+    assert all(_ao_nodes(t) for t in trees("Cycles")) and all(_ao_nodes(t) for t in trees("EEVEE"))

@@ -81,6 +81,17 @@ def _material(rng, n, **fixed):
     return m
 
 
+def _random_case(seed, n):
+    """(rng, a random environment, SH coefficients (a bright DC term), normals, views, material values) of ``n``
+    shading points drawn in that order from ``seed``; ``rng`` continues after them."""
+    rng = np.random.default_rng(seed)
+    env = _random_env(rng)
+    coeffs = rng.normal(size=(9, 3))
+    coeffs[0] += 4.0
+    normals, views = _geometry(rng, n)
+    return rng, env, coeffs, normals, views, _material(rng, n)
+
+
 def _params(coeffs, strength=1.0, rotation=(0.0, 0.0, 0.0)):
     p = {f"SH {i}": np.asarray(coeffs[i], np.float64) for i in range(9)}
     p["Strength"] = strength
@@ -231,13 +242,8 @@ def _function_values(material, m, normals, views, params):
 
 @pytest.mark.parametrize("features", ALL_FEATURES, ids=lambda f: f.label())
 def test_traced_world_equals_numpy(features):
-    rng = np.random.default_rng(7)
-    env = _random_env(rng)
-    coeffs = rng.normal(size=(9, 3))
-    coeffs[0] += 4.0
-    normals, views = _geometry(rng, 300)
+    rng, env, coeffs, normals, views, m = _random_case(7, 300)
     n = len(normals)
-    m = _material(rng, n)
     params = _params(coeffs, 1.7, (0.2, -0.4, 1.3))
     want = _radiance(features, env, params, m, normals, views)
     material = rt_lit.build_rt_lit(features, (), env)          # the whole material as the node groups get it
@@ -287,13 +293,8 @@ def _occluded_radiance(features, env, params, m, normals, views, ao):
 def test_occlusion_scales_the_diffuse_by_ao_and_the_specular_by_its_specular_occlusion(model):
     """world(AO) = AO x (the world without specular) + SO(N.V, AO, r) x (the specular part), SO from core/occlusion.py:
     the diffuse and the specular each take their own factor, nothing else changes."""
-    rng = np.random.default_rng(11)
-    env = _random_env(rng)
-    coeffs = rng.normal(size=(9, 3))
-    coeffs[0] += 4.0
-    normals, views = _geometry(rng, 300)
+    rng, env, coeffs, normals, views, m = _random_case(11, 300)
     n = len(normals)
-    m = _material(rng, n)
     params = _params(coeffs, 1.3, (0.3, 0.1, -0.7))
     ao = rng.uniform(0.0, 1.0, n)
     base = Features("turquin", "cod")
@@ -311,12 +312,7 @@ def test_occlusion_scales_the_diffuse_by_ao_and_the_specular_by_its_specular_occ
 def test_occlusion_at_ao_one_changes_nothing(model):
     """AO = 1 (nothing around the point): the occluded world equals the unoccluded one for the models that keep the
     whole lobe then (plain cones darken lobes reaching under the horizon: docs/benchmarks/specular_occlusion.md)."""
-    rng = np.random.default_rng(12)
-    env = _random_env(rng)
-    coeffs = rng.normal(size=(9, 3))
-    coeffs[0] += 4.0
-    normals, views = _geometry(rng, 200)
-    m = _material(rng, len(normals))
+    rng, env, coeffs, normals, views, m = _random_case(12, 200)
     params = _params(coeffs)
     features = Features("fdez_aguera", "cod", "zeltner", True)
     want = _radiance(features, env, params, m, normals, views)
@@ -330,13 +326,8 @@ def test_occlusion_at_ao_one_changes_nothing(model):
 def test_traced_occluded_world_equals_numpy(features):
     """The material function has the AO input exactly when the world is shaded and occluded, and evaluates like
     the direct numpy code (as test_traced_world_equals_numpy), float32 included."""
-    rng = np.random.default_rng(13)
-    env = _random_env(rng)
-    coeffs = rng.normal(size=(9, 3))
-    coeffs[0] += 4.0
-    normals, views = _geometry(rng, 300)
+    rng, env, coeffs, normals, views, m = _random_case(13, 300)
     n = len(normals)
-    m = _material(rng, n)
     params = _params(coeffs, 0.8, (0.2, -0.4, 1.3))
     ao = rng.uniform(0.0, 1.0, n)
     ao[:2] = (0.0, 1.0)
@@ -360,3 +351,27 @@ def test_occlusion_switch_validates_and_names_the_group():
         Features(occlusion="ssao")
     assert Features(occlusion="cones_clipped").label() == "turquin, cod, cones-clipped AO"
     assert Features.from_dict({"specular": "single"}).occlusion == "none"      # materials stored before the switch
+
+
+@pytest.mark.parametrize("rotation", [(0.0, 0.0, 0.0), (0.2, -0.4, 1.3)])
+def test_world_irradiance_output_is_the_sh_cosine_lobe_about_the_rotated_normal(rotation):
+    """The World shadows' denominator (``build_rt_lit(world_irradiance=True)``, addon/shadows.py): E_SH(N) / pi x
+    Strength (Ramamoorthi & Hanrahan 2001's cosine lobe, the world's rotation applied to the normal as its diffuse
+    does), in float64 and float32; the radiance is the same as without the extra output."""
+    rng, env, coeffs, normals, views, m = _random_case(11, 200)
+    params = _params(coeffs, 1.7, rotation)
+    rows = [np.asarray(r, np.float64) for r in world.euler_xyz_rows(np.asarray(rotation, np.float64))]
+    rotated = np.stack([normals @ r for r in rows], -1)
+    want = 1.7 * indirect.sh_cosine_lobe_eval(coeffs, rotated)
+    material = rt_lit.build_rt_lit(Features(), (), env, world_irradiance=True)
+    inputs = _function_values(material, m, normals, views, params)
+    both = ("Radiance", rt_lit.WORLD_IRRADIANCE_OUTPUT)
+    out = material.evaluate(inputs, TABLES["luts"], np.float64, outputs=both)
+    # rtol 1e-6: at the grazing views of _geometry's edge cases the shading normal (core/materials/surface.py) is
+    # the geometric one moved by its guard, by ~1e-7
+    np.testing.assert_allclose(out[rt_lit.WORLD_IRRADIANCE_OUTPUT], want, rtol=1e-6, atol=1e-12)
+    plain = rt_lit.build_rt_lit(Features(), (), env)
+    np.testing.assert_array_equal(out["Radiance"], plain.evaluate(inputs, TABLES["luts"], np.float64)["Radiance"])
+    out32 = material.evaluate(inputs, TABLES["luts"], np.float32, outputs=both)[rt_lit.WORLD_IRRADIANCE_OUTPUT]
+    assert out32.dtype == np.float32
+    np.testing.assert_allclose(out32, want, rtol=1e-5, atol=1e-5)

@@ -25,14 +25,18 @@ from ..harness import entry, outputs
 
 REPO = Path(__file__).resolve().parents[2]
 
-#: The rows: (section, occlusion model, light-shadow options or None).
-WORLD_ROWS = tuple(("world", model, None) for model in OCCLUSION_MODELS)
-LIGHT_ROWS = (("lights", "none", None), ("lights", "cones_clipped", None), ("lights", "lagarde", None),
-              ("lights", "none", {"samples": 4, "denoise": True}),
-              ("lights", "cones_clipped", {"samples": 4, "denoise": True}),
-              ("lights", "cones_clipped", {"samples": 16, "denoise": False}))
-QUICK_ROWS = (("world", "none", None), ("world", "cones_clipped", None), ("lights", "none", None),
-              ("lights", "cones_clipped", {"samples": 4, "denoise": True}))
+#: The rows: (section, occlusion model, ``shadows.enable_shadows`` options or None).  "world": True shadows the World
+#: term by its ratio too (the Cycles trees then leave the occlusion model out: addon/shadows.py).
+LIGHTS_ONLY = {"samples": 4, "denoise": True, "world": False}
+WORLD_ROWS = tuple(("world", model, None) for model in OCCLUSION_MODELS) + (
+    ("world", "none", {"samples": 4, "denoise": True, "world": True}),
+    ("world", "none", {"samples": 16, "denoise": True, "world": True}))
+LIGHT_ROWS = (("lights", "none", None), ("lights", "cones_clipped", None),
+              ("lights", "cones_clipped", LIGHTS_ONLY),
+              ("lights", "none", {"samples": 4, "denoise": True, "world": True}),
+              ("lights", "none", {"samples": 16, "denoise": True, "world": True}))
+QUICK_ROWS = (("world", "none", None), ("world", "none", {"samples": 4, "denoise": True, "world": True}),
+              ("lights", "none", None), ("lights", "cones_clipped", LIGHTS_ONLY))
 
 
 def _stats(values):
@@ -49,9 +53,13 @@ def _visibility(study, unoccluded):
     return dict(_stats(np.abs(rt / np.maximum(true, 1e-9) - 1.0)), rt_mean=float(rt.mean()), twin_mean=float(true.mean()))
 
 
-def row_label(model, light_shadows):
-    shadows = "none" if light_shadows is None else \
-        f"{light_shadows['samples']} spp{', OIDN' if light_shadows['denoise'] else ''}"
+def row_label(model, light_shadows, section="lights"):
+    if light_shadows is None:
+        shadows = "none"
+    else:
+        world = light_shadows.get("world", True)
+        what = ("world" if section == "world" else "lights + world") if world else "lights"
+        shadows = f"{what}, {light_shadows['samples']} spp{', OIDN' if light_shadows['denoise'] else ''}"
     return f"{model} | {shadows}"
 
 
@@ -70,14 +78,16 @@ def run(args, progress=entry.flush_log):
                "median": floor["median"], "p90": floor["p90"], "noise_median": floor["noise_median"],
                "darkened_median": dark["median"], "darkened_p90": dark["p90"],
                "floor_unshadowed_twin_median": study["floor_without_shadows"]["median"],
-               "rt_lit_seconds": study["seconds"]["rt_lit_cycles"], "rt_lit_samples": study["rt_lit_samples"]}
+               "rt_lit_seconds": study["seconds"]["rt_lit_cycles"], "rt_lit_samples": study["rt_lit_samples"],
+               "spheres": study["spheres"]}
         if model == "none" and light_shadows is None:
             plain[section] = study
         elif light_shadows is None and section in plain:
             row["visibility"] = _visibility(study, plain[section])
         result["rows"].append(row)
-        progress(f"[floor shadows] {section}, {row_label(model, light_shadows)}: floor median {row['median']:.1%}, "
-                 f"p90 {row['p90']:.1%}; darkened pixels median {row['darkened_median']:.1%}")
+        progress(f"[floor shadows] {section}, {row_label(model, light_shadows, section)}: floor median {row['median']:.1%}, "
+                 f"p90 {row['p90']:.1%}; darkened pixels median {row['darkened_median']:.1%}; spheres median "
+                 f"{row['spheres']['all']['median']:.1%}, glossy {row['spheres']['glossy']['median']:.1%}")
     outputs.write_results(args.out, "floor_shadows", result, to_markdown(result))
     return result
 
@@ -88,20 +98,23 @@ def to_markdown(result):
              " docs/shadows.md).  The lookdev scene with its floor against its path-traced twin "
              f"({result['resolution'][0]} x {result['resolution'][1]}, the twin at {result['samples']} spp x 2 seeds, "
              "0 bounces): the floor's per-pixel relative error, median / p90, over all its pixels and over those path "
-             "tracing darkens by more than 5%.  Light shadows: the ratio estimator's probe layers (samples, denoiser); "
-             "none: unshadowed lights.  Visibility (world occlusion without light shadows): RT Lit's occluded floor "
+             "tracing darkens by more than 5%; the spheres' over all their pixels and over the glossy ones (roughness "
+             "<= 0.25).  Shadows: the ratio estimator's probe layers (samples, denoiser) on the lights, or on the lights "
+             "and the World term (addon/shadows.py); none: unshadowed.  Visibility (world occlusion without light shadows): RT Lit's occluded floor "
              "over its unoccluded one against the twin's shadowed floor over its unshadowed one, |ratio - 1| per "
              "pixel, and the two means over the floor.", ""]
     for section, title in (("world", "The world alone (the studio lights removed)"),
                            ("lights", "The world and the studio lights")):
-        lines += [f"## {title}", "", "| World Occlusion | light shadows | floor | darkened pixels | visibility error | "
-                  "mean visibility, RT Lit / twin | RT Lit render |", "|---|---|---|---|---|---|---|"]
+        lines += [f"## {title}", "", "| World Occlusion | shadows | floor | darkened pixels | spheres | glossy spheres |"
+                  " visibility error | mean visibility, RT Lit / twin | RT Lit render |",
+                  "|---|---|---|---|---|---|---|---|---|"]
         for row in (r for r in result["rows"] if r["section"] == section):
             vis = row.get("visibility")
             vis_cells = (f"{vis['median']:.1%} / {vis['p90']:.1%} | {vis['rt_mean']:.2f} / {vis['twin_mean']:.2f}"
                          if vis else "- | -")
-            lines.append(f"| {row_label(row['occlusion'], row['light_shadows'])} | {row['median']:.1%} / "
-                         f"{row['p90']:.1%} | {row['darkened_median']:.1%} / {row['darkened_p90']:.1%} | {vis_cells} | "
+            lines.append(f"| {row_label(row['occlusion'], row['light_shadows'], row['section'])} | {row['median']:.1%} / "
+                         f"{row['p90']:.1%} | {row['darkened_median']:.1%} / {row['darkened_p90']:.1%} | "
+                         f"{_cell(row['spheres']['all'])} | {_cell(row['spheres']['glossy'])} | {vis_cells} | "
                          f"{row['rt_lit_seconds']:.1f} s ({row['rt_lit_samples']} spp) |")
         unshadowed = next((r["floor_unshadowed_twin_median"] for r in result["rows"]
                            if r["section"] == section and r["occlusion"] == "none" and r["light_shadows"] is None), None)
@@ -109,10 +122,31 @@ def to_markdown(result):
             lines += ["", f"Unshadowed RT Lit against the twin without the spheres' shadows (the residual the shadows "
                       f"cannot remove): {unshadowed:.1%} median."]
         lines.append("")
+    lines += _per_sphere(result["rows"])
     lines += ["The twin's own noise (median of its two seeds' half-difference) is "
               f"{result['rows'][0]['noise_median']:.1%} on the floor.  The render times are one run each, as the study "
               "ran them (not a speed measurement).", ""]
     return "\n".join(lines)
+
+
+def _per_sphere(rows):
+    """A table of each sphere's median error per row (the spheres' names without the scene's)."""
+    names = list(rows[0]["spheres"]["per_sphere"]) if rows else []
+    if not names:
+        return []
+    short = [" ".join(n.split()[-2:]) for n in names]
+    lines = ["## Each sphere (median error against the twin)", "",
+             "| section | World Occlusion | shadows | " + " | ".join(short) + " |",
+             "|---|---|---|" + "---|" * len(names)]
+    for row in rows:
+        per = row["spheres"]["per_sphere"]
+        lines.append(f"| {row['section']} | {row_label(row['occlusion'], row['light_shadows'], row['section'])} | "
+                     + " | ".join(f"{per[n]:.1%}" if n in per else "-" for n in names) + " |")
+    return lines + [""]
+
+
+def _cell(stats):
+    return f"{stats['median']:.1%} / {stats['p90']:.1%}" if stats.get("values") else "-"
 
 
 def parse_args(argv):

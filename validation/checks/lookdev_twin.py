@@ -392,11 +392,42 @@ def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, fea
     rel, _ = metrics.rel_values(result["images"]["rt_lit"], result["images"]["path_traced"], dark, FLOOR_FRACTION)
     out["floor_darkened"] = _stats(rel)
     out["light_shadows"] = light_shadows
+    out["spheres"] = _sphere_study(result, index)
     out["floor_mask"] = floor_mask          # (H, W) bool: the floor pixels compared (not JSON: ``run`` drops it)
     log(f"[twin] floor study: {out['floor_shadowed_fraction']:.1%} of the floor darkened > 5% by shadows; floor "
         f"median error {out['floor_with_shadows']['median']:.2%} with, {out['floor_without_shadows']['median']:.2%} "
         "without the shadows")
     return out
+
+
+def _sphere_study(result, floor_index):
+    """The spheres' error against the twin (with shadows): pooled over all sphere pixels ("all"), over the glossy ones
+    (roughness <= ``GLOSSY_MAX``: where a visibility ratio taken from a diffuse probe is most wrong), and per sphere
+    (median)."""
+    names = result["spheres"]
+    interior = metrics.interior_pixels(result["index"])
+    groups = {"all": [i for i, n in enumerate(names, 1) if i != floor_index],
+              "glossy": [i for i, n in enumerate(names, 1) if i != floor_index and _roughness(n) <= GLOSSY_MAX]}
+    out = {}
+    for group, indices in groups.items():
+        mask = interior & np.isin(result["index"], indices)
+        rel, _ = metrics.rel_values(result["images"]["rt_lit"], result["images"]["path_traced"], mask, FLOOR_FRACTION)
+        out[group] = _stats(rel)
+    out["per_sphere"] = {n: result["with_shadows"][n]["median"] for i, n in enumerate(names, 1)
+                         if i != floor_index and n in result["with_shadows"]}
+    return out
+
+
+#: The spheres the sphere study counts as glossy (their roughness, the number after " r" in their name).
+GLOSSY_MAX = 0.25
+
+
+def _roughness(name):
+    tail = name.rsplit(" r", 1)
+    try:
+        return float(tail[1]) if len(tail) == 2 else float("inf")
+    except ValueError:
+        return float("inf")
 
 
 def _floor_mask(result, index):
