@@ -34,8 +34,8 @@ def test_concave_scene_builds_and_its_twin_copies_every_rt_lit_object(empty_scen
 
 
 def test_shadows_lower_the_error_on_the_concave_scene(bpy_module, lut_dir):
-    """Unshadowed RT Lit against the default shadows (world occlusion clipped cones, light shadows at 4 probe samples
-    with OIDN), both measured against one twin reference over every RT Lit object's pixels."""
+    """Unshadowed RT Lit against the default shadows (the lights' and the World term's, 4 probe samples with OIDN),
+    both measured against one twin reference over every RT Lit object's pixels."""
     from rt_lookdev.validation.benchmarks import concave_shadows_benchmark as benchmark
     from rt_lookdev.validation.checks import lookdev_twin
 

@@ -29,22 +29,26 @@ from ..harness import entry, outputs, png
 
 REPO = Path(__file__).resolve().parents[2]
 
-#: World occlusion's model in the shadowed rows (the most accurate of docs/benchmarks/specular_occlusion.md).
+#: World occlusion's model in the rows that occlude the world by AO (the most accurate of
+#: docs/benchmarks/specular_occlusion.md).
 OCCLUSION = "cones_clipped"
-#: The default of ``shadows.enable_shadows`` (4 probe samples, OIDN): the acceptance row of issue 29.
-DEFAULT_SHADOWS = {"samples": 4, "denoise": True}
+#: The default of ``shadows.enable_shadows`` (4 probe samples, OIDN, the World term shadowed too): the acceptance row
+#: of issue 29.
+DEFAULT_SHADOWS = {"samples": 4, "denoise": True, "world": True}
 SHADOW_SAMPLES = (1, 2, 4, 8, 16, 32, 64)
 UNSHADOWED = {"features": {}, "light_shadows": None}
 OCCLUDED = {"features": {"occlusion": OCCLUSION}, "light_shadows": None}
-ROWS = (UNSHADOWED, OCCLUDED) + tuple({"features": {"occlusion": OCCLUSION},
-                                       "light_shadows": dict(DEFAULT_SHADOWS, samples=n)} for n in SHADOW_SAMPLES)
-QUICK_ROWS = (UNSHADOWED, {"features": {"occlusion": OCCLUSION}, "light_shadows": dict(DEFAULT_SHADOWS)})
+#: The lights' shadows with the world occluded by AO (the setup before the World term's shadows).
+LIGHTS_AND_AO = {"features": {"occlusion": OCCLUSION}, "light_shadows": dict(DEFAULT_SHADOWS, world=False)}
+ROWS = (UNSHADOWED, OCCLUDED, LIGHTS_AND_AO) + tuple(
+    {"features": {}, "light_shadows": dict(DEFAULT_SHADOWS, samples=n)} for n in SHADOW_SAMPLES)
+QUICK_ROWS = (UNSHADOWED, {"features": {}, "light_shadows": dict(DEFAULT_SHADOWS)})
 #: The split (full run only): (key, title, ``concave_study`` options, rows): the lights alone and the world alone,
 #: each against its own twin reference, one render per row, no curve.
 SPLIT = (("lights_only", "The studio lights alone (no world)", {"world": False},
           (UNSHADOWED, {"features": {}, "light_shadows": dict(DEFAULT_SHADOWS)})),
          ("world_only", "The world alone (the studio lights removed)", {"lights": False},
-          (UNSHADOWED, OCCLUDED)))
+          (UNSHADOWED, OCCLUDED, {"features": {}, "light_shadows": dict(DEFAULT_SHADOWS)})))
 #: (resolution, reference spp, path tracing's curve) of the full run and of ``--quick``.
 FULL = ((256, 192), 64, lookdev_twin.PATH_TRACING_SPP)
 QUICK = ((64, 48), 8, (1, 4))
@@ -54,8 +58,9 @@ def shadows_label(light_shadows):
     """A row's light-shadow options in words: "none", "4 spp, OIDN", other options as key=value."""
     if light_shadows is None:
         return "none"
-    words = [f"{light_shadows.get('samples', 4)} spp"] + (["OIDN"] if light_shadows.get("denoise", True) else [])
-    words += [f"{k}={v}" for k, v in light_shadows.items() if k not in ("samples", "denoise")]
+    what = "lights + world" if light_shadows.get("world", True) else "lights"
+    words = [what, f"{light_shadows.get('samples', 4)} spp"] + (["OIDN"] if light_shadows.get("denoise", True) else [])
+    words += [f"{k}={v}" for k, v in light_shadows.items() if k not in ("samples", "denoise", "world")]
     return ", ".join(words)
 
 
