@@ -7,6 +7,10 @@ Blender's own, baked for the World term), an orthographic camera, and render set
 Cycles with 0 bounces (RT Lit surfaces are emitters: with bounces they would light each other a second
 time), the view transform the artist picks (AgX or Standard).
 
+``new_concave_scene(...)`` builds issue 29's asset-like concave scene the same way: a torus resting on the floor of an
+open box and a Suzanne beside it (objects that touch and shadow each other), RT Lit from Principled, the same lights
+and world, a perspective camera (``validation.checks.lookdev_twin.concave_study`` measures it).
+
 ``add_path_traced_twin(scene)`` adds the scene's twin: a scene "<name> Path Traced" with the same world and
 camera that holds every object the scene renders.  An object with an RT Lit material in some slot is copied
 (same data and modifiers, transform copied from the original by a constraint, so moving a sphere moves its
@@ -265,6 +269,149 @@ def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world
     if floor:
         bottom = 0.5 * SPACING * (len(ROWS) - 1) - (len(ROWS) - 1) * SPACING - RADIUS
         _floor(name, collection, bottom, lut_dir, scene, features.occlusion)
+    return scene
+
+
+# --- the concave scene ---------------------------------------------------------------------------------
+
+#: The concave scene's open box (floor and three walls, open at the front and the top), its torus and Suzanne (m).
+BOX_HALF = 1.2
+BOX_HEIGHT = 1.0
+TORUS_RADII = (0.42, 0.14)           # major, minor
+TORUS_LOCATION = (-0.45, -0.25, TORUS_RADII[1])
+SUZANNE_SCALE = 0.42
+#: Suzanne's mesh (``bmesh.ops.create_monkey``) reaches 0.98 below its origin: she sits on the floor.
+SUZANNE_LOCATION = (0.35, 0.2, 0.98 * SUZANNE_SCALE)
+SUZANNE_TURN = math.radians(-20.0)
+#: (object, Principled inputs): a grey rough box, a coloured rough torus, a copper Suzanne (the preset "RTL Copper"'s
+#: measured F0, core/materials/presets.py).
+CONCAVE_MATERIALS = (
+    ("Box", {"Base Color": (0.55, 0.55, 0.55, 1.0), "Roughness": 0.8, "Metallic": 0.0}),
+    ("Torus", {"Base Color": (0.1, 0.35, 0.8, 1.0), "Roughness": 0.45, "Metallic": 0.0}),
+    ("Suzanne", {"Base Color": (0.955, 0.637, 0.538, 1.0), "Roughness": 0.35, "Metallic": 1.0}),
+)
+#: The perspective camera: where it stands, the point it looks at, its lens (mm, 36 mm sensor).
+CONCAVE_CAMERA = ((0.0, -4.3, 2.6), (0.0, 0.1, 0.3), 42.0)
+
+
+def open_box_mesh(name, half=BOX_HALF, height=BOX_HEIGHT):
+    """A floor (2 ``half`` square at z = 0) and three walls of ``height`` (left, right, back: open towards -y and
+    the top), every face's normal pointing into the box."""
+    a, h = half, height
+    verts = [(-a, -a, 0), (a, -a, 0), (a, a, 0), (-a, a, 0), (-a, -a, h), (a, -a, h), (a, a, h), (-a, a, h)]
+    faces = [(0, 1, 2, 3),          # floor, +z
+             (3, 2, 6, 7),          # back wall (y = a), -y
+             (0, 3, 7, 4),          # left wall (x = -a), +x
+             (1, 5, 6, 2)]          # right wall (x = a), -x
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(verts, [], faces)
+    mesh.update()
+    return mesh
+
+
+def torus_mesh(name, radii=TORUS_RADII, segments=(64, 24)):
+    """A smooth torus around the z axis (major, minor radius), its normals outwards."""
+    (big, small), (nu, nv) = radii, segments
+    verts = []
+    for i in range(nu):
+        u = 2.0 * math.pi * i / nu
+        for j in range(nv):
+            v = 2.0 * math.pi * j / nv
+            ring = big + small * math.cos(v)
+            verts.append((ring * math.cos(u), ring * math.sin(u), small * math.sin(v)))
+    faces = [(i * nv + j, ((i + 1) % nu) * nv + j, ((i + 1) % nu) * nv + (j + 1) % nv, i * nv + (j + 1) % nv)
+             for i in range(nu) for j in range(nv)]
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(verts, [], faces)
+    mesh.update()
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    return mesh
+
+
+def suzanne_mesh(name, scale=SUZANNE_SCALE, subdivisions=1):
+    """Blender's monkey (``bmesh.ops.create_monkey``, facing -y), scaled, subdivided once (smooth), smooth shaded."""
+    import bmesh
+    from mathutils import Matrix
+
+    bm = bmesh.new()
+    bmesh.ops.create_monkey(bm, matrix=Matrix.Scale(scale, 4))
+    if subdivisions:
+        bmesh.ops.subdivide_edges(bm, edges=bm.edges, cuts=subdivisions, use_grid_fill=True, smooth=1.0)
+    mesh = bpy.data.meshes.new(name)
+    bm.to_mesh(mesh)
+    bm.free()
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    return mesh
+
+
+def perspective_camera(name, location, target, lens, collection):
+    """A perspective camera at ``location`` looking at ``target`` (its up towards +z), ``lens`` mm on a 36 mm
+    sensor."""
+    from mathutils import Vector
+
+    data = bpy.data.cameras.new(name)
+    data.type = "PERSP"
+    data.lens = lens
+    data.sensor_width = 36.0
+    cam = bpy.data.objects.new(name, data)
+    cam.location = location
+    cam.rotation_euler = (Vector(target) - Vector(location)).to_track_quat("-Z", "Y").to_euler()
+    collection.objects.link(cam)
+    return cam
+
+
+def _concave_objects(name, collection):
+    """{label: object} of the open box, the torus resting on its floor and Suzanne sitting beside it."""
+    box = bpy.data.objects.new(f"{name} Box", open_box_mesh(f"{name} Box"))
+    torus = bpy.data.objects.new(f"{name} Torus", torus_mesh(f"{name} Torus"))
+    torus.location = TORUS_LOCATION
+    suzanne = bpy.data.objects.new(f"{name} Suzanne", suzanne_mesh(f"{name} Suzanne"))
+    suzanne.location = SUZANNE_LOCATION
+    suzanne.rotation_euler = (0.0, 0.0, SUZANNE_TURN)
+    objects = {"Box": box, "Torus": torus, "Suzanne": suzanne}
+    for obj in objects.values():
+        collection.objects.link(obj)
+    return objects
+
+
+def new_concave_scene(name="RT Concave", features=None, hdri=DEFAULT_HDRI, world_strength=1.0,
+                      view_transform="AgX", lut_dir=None, resolution=(640, 480)):
+    """An asset-like concave scene (issue 29) as a new scene of the current file; returns it.  A torus resting on
+    the floor of an open box (floor, left, right and back walls; open towards the camera and the top) and a smooth
+    Suzanne sitting beside it, so objects touch and shadow each other; RT Lit materials converted from Principled
+    (``CONCAVE_MATERIALS``: grey rough box, blue rough torus, copper Suzanne), every one with ``features``
+    (default ``Features()``); the studio lights and HDRI world of ``new_lookdev_scene``; a perspective camera
+    looking into the box from the front, above."""
+    from ..core.materials.rt_lit_interface import Features
+    from . import convert, materials
+    from . import world_sync as rtl_world
+
+    features = features or Features()
+    scene = bpy.data.scenes.new(name)
+    configure_lookdev_render(scene, view_transform)
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
+    collection = scene.collection
+    scene.world = None
+    if hdri is not None:
+        world = add_hdri_world(scene, hdri, world_strength, name=f"{name} {hdri}")
+        world.cycles.sampling_method = "AUTOMATIC"   # the twin path-traces this world
+    rtl_world.sync_world(scene)
+    _studio_lights(collection)
+    materials.sync_scene_lights(scene)
+
+    def factory(feats):
+        return materials.ensure_rt_lit_group(feats, scene, lut_dir)
+
+    objects = _concave_objects(name, collection)
+    for label, values in CONCAVE_MATERIALS:
+        mat = principled_material(f"{name} {label}", values)
+        convert.principled_to_rt_lit(mat, factory, features)
+        objects[label].data.materials.append(mat)
+    location, target, lens = CONCAVE_CAMERA
+    scene.camera = perspective_camera(f"{name} Camera", location, target, lens, collection)
     return scene
 
 

@@ -57,6 +57,7 @@ RUN_BY = {
     "scripts/benchmark_metal_split.py": "here",
     "scripts/benchmark_specular_occlusion.py": "here",
     "scripts/benchmark_floor_shadows.py": "here",
+    "scripts/benchmark_concave_shadows.py": "here",
     "scripts/benchmark_eevee_shadows.py": "here",
 }
 
@@ -82,6 +83,8 @@ SMOKE = {
     "scripts/benchmark_specular_occlusion.py": (["--quick", "--out", "{out}"],
                                                 ["specular_occlusion.md", "specular_occlusion.json"]),
     "scripts/benchmark_floor_shadows.py": (["--quick", "--out", "{out}"], ["floor_shadows.md", "floor_shadows.json"]),
+    "scripts/benchmark_concave_shadows.py": (["--quick", "--out", "{out}"],
+                                             ["concave_shadows.md", "concave_shadows.json", "concave_shadows.png"]),
     "scripts/benchmark_eevee_shadows.py": (["--quick", "--out", "{out}"], ["eevee_shadows.md", "eevee_shadows.json"]),
 }
 

@@ -30,6 +30,7 @@ CONVERTED = {
     "benchmarks/specular_occlusion_benchmark": "benchmark_specular_occlusion.py",
     "benchmarks/wrapped_diffuse_benchmark": "benchmark_wrapped_diffuse.py",
     "benchmarks/floor_shadows_benchmark": "benchmark_floor_shadows.py",
+    "benchmarks/concave_shadows_benchmark": "benchmark_concave_shadows.py",
     "benchmarks/eevee_shadows_benchmark": "benchmark_eevee_shadows.py",
 }
 

@@ -118,54 +118,113 @@ def sphere_errors(a, reference_pair, index, names):
     return out
 
 
-def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee=True, log=print, rt_lit_samples=1):
-    """Measure the lookdev ``scene`` against its ``twin`` (module doc); returns a JSON-able dict.  ``rt_lit_samples``:
-    Cycles samples of (a), 1 unless its materials trace something (world occlusion's Ambient Occlusion node)."""
+def twin_copies(twin):
+    """{name of the original: its copy} of the twin's copies of RT Lit objects."""
     from ...addon import lookdev_scene
 
-    spheres = lookdev_scene.lookdev_spheres(scene)
-    names = [o.name for o in spheres]
-    twins = {o[lookdev_scene.TWIN_SOURCE_KEY]: o for o in twin.objects if lookdev_scene.TWIN_SOURCE_KEY in o.keys()}
-    for i, obj in enumerate(spheres, start=1):
+    key = lookdev_scene.TWIN_SOURCE_KEY
+    return {o[key]: o for o in twin.objects if key in o.keys()}
+
+
+def number_objects(scene, twin):
+    """Give the RT Lit objects of ``scene`` object indices 1, 2, ... in name order (``lookdev_spheres``) and their
+    copies in ``twin`` the same; returns their names."""
+    from ...addon import lookdev_scene
+
+    objects = lookdev_scene.lookdev_spheres(scene)
+    copies = twin_copies(twin)
+    for i, obj in enumerate(objects, start=1):
         obj.pass_index = i
-        if obj.name in twins:
-            twins[obj.name].pass_index = i
-    result = {"resolution": list(resolution), "samples": samples, "seeds": list(seeds),
-              "bounces": twin.cycles.max_bounces, "spheres": names}
-    with tempfile.TemporaryDirectory(prefix="rtl-twin-") as tmp:
-        a, index, t_a = render_measurement(scene, resolution, rt_lit_samples, 0, tmp)
-        log(f"[twin] RT Lit (Cycles, {rt_lit_samples} sample{'s' if rt_lit_samples > 1 else ''}): {t_a:.2f} s")
-        refs, times = [], []
-        for seed in seeds:
-            ref, ref_index, t = render_measurement(twin, resolution, samples, seed, tmp)
-            refs.append(ref)
-            times.append(t)
-        log(f"[twin] path traced ({samples} spp x {len(seeds)} seeds): {sum(times):.1f} s")
-        index = np.where(ref_index == index, index, 0)     # both renders must show the same object
-        result["with_shadows"] = sphere_errors(a, refs, index, names)
-        twin_spheres = list(twins.values())
-        saved = [{a: getattr(o, a) for a in RAY_VISIBILITY} for o in twin_spheres]
-        try:
-            for o in twin_spheres:           # seen by the camera only: no shadow, no occlusion of the world
-                for attr in RAY_VISIBILITY:
-                    setattr(o, attr, False)
-            unshadowed = [render_measurement(twin, resolution, samples, seed, tmp)[0] for seed in seeds]
-        finally:
-            for o, flags in zip(twin_spheres, saved):
-                for attr, flag in flags.items():
-                    setattr(o, attr, flag)
-        result["without_shadows"] = sphere_errors(a, unshadowed, index, names)
-        shadow_mean = 0.5 * (refs[0] + refs[1])
-        free_mean = 0.5 * (unshadowed[0] + unshadowed[1])
+        if obj.name in copies:
+            copies[obj.name].pass_index = i
+    return [o.name for o in objects]
+
+
+@contextlib.contextmanager
+def twin_unshadowed(twin):
+    """The twin's copies seen by camera rays only (``RAY_VISIBILITY`` off): no shadow, no occlusion of the world."""
+    copies = list(twin_copies(twin).values())
+    saved = [{a: getattr(o, a) for a in RAY_VISIBILITY} for o in copies]
+    try:
+        for o in copies:
+            for attr in RAY_VISIBILITY:
+                setattr(o, attr, False)
+        yield
+    finally:
+        for o, flags in zip(copies, saved):
+            for attr, flag in flags.items():
+                setattr(o, attr, flag)
+
+
+def render_reference(twin, names, resolution, samples, seeds, folder, log=print, unshadowed=True):
+    """The twin path traced at ``samples`` spp once per seed, and (``unshadowed``) again with its copies seen by the
+    camera only: {"names", "resolution", "samples", "seeds", "shadowed": [RGB per seed], "unshadowed": [...] or
+    None, "index": object index, "seconds": [per shadowed render]}.  ``names``: ``number_objects``'s."""
+    shadowed, times = [], []
+    for seed in seeds:
+        image, index, seconds = render_measurement(twin, resolution, samples, seed, folder)
+        shadowed.append(image)
+        times.append(seconds)
+    log(f"[twin] path traced ({samples} spp x {len(seeds)} seeds): {sum(times):.1f} s")
+    free = None
+    if unshadowed:
+        with twin_unshadowed(twin):
+            free = [render_measurement(twin, resolution, samples, seed, folder)[0] for seed in seeds]
+    return {"names": list(names), "resolution": list(resolution), "samples": samples, "seeds": list(seeds),
+            "shadowed": shadowed, "unshadowed": free, "index": index, "seconds": times}
+
+
+def render_rt_lit(scene, resolution, samples, folder, runs=1):
+    """The RT Lit render ``runs`` times (the same image each time): (RGB, object index, [seconds per run])."""
+    times = []
+    for _ in range(max(1, int(runs))):
+        image, index, seconds = render_measurement(scene, resolution, samples, 0, folder)
+        times.append(seconds)
+    return image, index, times
+
+
+def reference_errors(a, index, reference):
+    """``a`` (with its object ``index``) against the reference (``render_reference``): {"index": the pixels both
+    show the same object in, "with_shadows", "without_shadows" (None without the unshadowed twin): per object and
+    "all" (``sphere_errors``), "shadowed_fraction": the interior pixels the twin's shadows darken by > 5%}."""
+    names, refs, free = reference["names"], reference["shadowed"], reference["unshadowed"]
+    index = np.where(reference["index"] == index, index, 0)     # both renders must show the same object
+    out = {"index": index, "with_shadows": sphere_errors(a, refs, index, names),
+           "without_shadows": sphere_errors(a, free, index, names) if free is not None else None}
+    if free is not None:
+        shadow_mean, free_mean = 0.5 * (refs[0] + refs[1]), 0.5 * (free[0] + free[1])
         sel = metrics.interior_pixels(index) & (free_mean.max(axis=-1) > 0)
         darkened = (free_mean - shadow_mean).max(axis=-1)[sel] / np.maximum(free_mean.max(axis=-1)[sel], 1e-12)
-        result["shadowed_fraction"] = float((darkened > 0.05).mean()) if darkened.size else 0.0
-        result["seconds"] = {"rt_lit_cycles": t_a, "path_traced": float(np.median(times))}
+        out["shadowed_fraction"] = float((darkened > 0.05).mean()) if darkened.size else 0.0
+    return out
+
+
+def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee=True, log=print, rt_lit_samples=1,
+            reference=None, runs=1):
+    """Measure the lookdev ``scene`` against its ``twin`` (module doc); returns a JSON-able dict.  ``rt_lit_samples``:
+    Cycles samples of (a), 1 unless its materials trace something (world occlusion's Ambient Occlusion node).
+    ``reference``: a ``render_reference`` of an identical twin to measure against instead of rendering one (its
+    objects must have the same names); ``runs``: times (a) is rendered (its seconds: the median)."""
+    names = number_objects(scene, twin)
+    with tempfile.TemporaryDirectory(prefix="rtl-twin-") as tmp:
+        a, index, t_a = render_rt_lit(scene, resolution, rt_lit_samples, tmp, runs)
+        log(f"[twin] RT Lit (Cycles, {rt_lit_samples} sample{'s' if rt_lit_samples > 1 else ''}): "
+            f"{float(np.median(t_a)):.2f} s")
+        if reference is None:
+            reference = render_reference(twin, names, resolution, samples, seeds, tmp, log)
+        elif reference["names"] != names or reference["resolution"] != list(resolution):
+            raise ValueError("the reference was rendered for other objects or another resolution")
+        result = {"resolution": list(resolution), "samples": reference["samples"], "seeds": reference["seeds"],
+                  "bounces": twin.cycles.max_bounces, "spheres": names}
+        result.update(reference_errors(a, index, reference))
+        result["seconds"] = {"rt_lit_cycles": float(np.median(t_a)), "rt_lit_runs": t_a,
+                             "path_traced": float(np.median(reference["seconds"]))}
         if eevee:
-            result["eevee"] = _eevee_against_cycles(scene, resolution, a, index, tmp, log)
-        result["index"] = index
-        result["images"] = {"rt_lit": a.astype(np.float32), "path_traced": shadow_mean.astype(np.float32),
-                            "path_traced_no_shadows": free_mean.astype(np.float32)}
+            result["eevee"] = _eevee_against_cycles(scene, resolution, a, result["index"], tmp, log)
+        refs, free = reference["shadowed"], reference["unshadowed"]
+        result["images"] = {"rt_lit": a.astype(np.float32), "path_traced": (0.5 * (refs[0] + refs[1])).astype(np.float32)}
+        if free is not None:
+            result["images"]["path_traced_no_shadows"] = (0.5 * (free[0] + free[1])).astype(np.float32)
     return result
 
 
@@ -252,7 +311,7 @@ def checks(result):
     return out
 
 
-def _display(rgb):
+def display(rgb):
     """A preview of a linear render: x / (1 + x), gamma 2.2."""
     x = np.clip(np.nan_to_num(np.asarray(rgb, np.float64)), 0.0, None)
     return np.clip(x / (1.0 + x), 0.0, 1.0) ** (1 / 2.2)
@@ -266,7 +325,7 @@ def write_pictures(result, folder, prefix="lookdev_"):
     paths = []
     for key, image in result["images"].items():
         path = folder / f"{prefix}{key}.png"
-        png.write_rgb(path, _display(image))
+        png.write_rgb(path, display(image))
         paths.append(path)
     return paths
 
@@ -275,24 +334,23 @@ def write_pictures(result, folder, prefix="lookdev_"):
 OCCLUSION_SAMPLES = 32
 
 
-def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, features=None, lights=True,
-                 light_shadows=None):
-    """The lookdev scene with its floor (``new_lookdev_scene(floor=True)``) against its twin: how much of the
-    floor the spheres shadow in path tracing, and the error that leaves on it.  ``features``: the RT Lit
-    switches of every material (default ``Features()``: nothing occluded); with world occlusion on, the RT Lit
-    render takes ``OCCLUSION_SAMPLES``.  ``lights``: False removes the studio lights (the world alone).
-    ``light_shadows``: None, or the options of ``shadows.enable_shadows`` ({"samples": 4, "denoise": True}):
-    the lights' shadows by the ratio estimator, set up after the twin is made.  The result's
-    "floor_darkened" is the floor's error over the pixels path tracing darkens by more than 5%."""
+def rt_lit_samples_for(features):
+    """Cycles samples of the RT Lit render of materials with ``features``: 1, ``OCCLUSION_SAMPLES`` with world
+    occlusion (its Ambient Occlusion node traces)."""
+    return 1 if features.occlusion == "none" else OCCLUSION_SAMPLES
+
+
+def study_scene(build, lut_dir=None, lights=True, light_shadows=None):
+    """A fresh file holding the scene ``build()`` makes and its twin: (scene, twin).  ``lights``: False removes the
+    lights (the world alone); ``light_shadows``: None, or the options of ``shadows.enable_shadows`` as keyword
+    arguments ({"samples": 4, "denoise": True}): the lights' shadows by the ratio estimator, set up after the twin
+    is made."""
     import bpy
 
     from ...addon import light_sync, lookdev_scene, shadows
-    from ...core.materials.rt_lit_interface import Features
 
-    features = features or Features()
     bpy.ops.wm.read_homefile(use_empty=True)
-    scene = lookdev_scene.new_lookdev_scene("Floor Study", features, view_transform="Standard", lut_dir=lut_dir,
-                                            floor=True)
+    scene = build()
     if not lights:
         for obj in [o for o in scene.objects if o.type == "LIGHT"]:
             bpy.data.objects.remove(obj)
@@ -300,14 +358,30 @@ def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, fea
     twin = lookdev_scene.add_path_traced_twin(scene)
     if light_shadows is not None:
         shadows.enable_shadows(scene, lut_dir=lut_dir, **light_shadows)
-    result = compare(scene, twin, resolution, samples, eevee=False, log=log,
-                     rt_lit_samples=1 if features.occlusion == "none" else OCCLUSION_SAMPLES)
+    return scene, twin
+
+
+def shadow_study(lut_dir=None, resolution=(320, 200), samples=64, log=print, features=None, lights=True,
+                 light_shadows=None):
+    """The lookdev scene with its floor (``new_lookdev_scene(floor=True)``) against its twin: how much of the
+    floor the spheres shadow in path tracing, and the error that leaves on it.  ``features``: the RT Lit
+    switches of every material (default ``Features()``: nothing occluded); with world occlusion on, the RT Lit
+    render takes ``OCCLUSION_SAMPLES``.  ``lights``, ``light_shadows``: as ``study_scene``.  The result's
+    "floor_darkened" is the floor's error over the pixels path tracing darkens by more than 5%."""
+    from ...addon import lookdev_scene
+    from ...core.materials.rt_lit_interface import Features
+
+    features = features or Features()
+    scene, twin = study_scene(lambda: lookdev_scene.new_lookdev_scene("Floor Study", features, view_transform="Standard",
+                                                                       lut_dir=lut_dir, floor=True),
+                              lut_dir, lights, light_shadows)
+    result = compare(scene, twin, resolution, samples, eevee=False, log=log, rt_lit_samples=rt_lit_samples_for(features))
     floor = f"{scene.name} Floor"
     index = result["spheres"].index(floor) + 1
     out = {"resolution": list(resolution), "samples": samples, "features": features.label(), "lights": lights,
            "floor_with_shadows": result["with_shadows"].get(floor), "floor_without_shadows": result["without_shadows"].get(floor),
            "shadowed_fraction_all": result["shadowed_fraction"], "images": result["images"],
-           "seconds": result["seconds"], "rt_lit_samples": 1 if features.occlusion == "none" else OCCLUSION_SAMPLES}
+           "seconds": result["seconds"], "rt_lit_samples": rt_lit_samples_for(features)}
     shadowed = result["images"]["path_traced"].max(axis=-1)
     free = result["images"]["path_traced_no_shadows"].max(axis=-1)
     floor_mask = _floor_mask(result, index)
@@ -358,6 +432,76 @@ def _roughness(name):
 
 def _floor_mask(result, index):
     return metrics.interior_pixels(result["index"]) & (result["index"] == index)
+
+
+#: Path tracing's own curve on the concave study: the twin at these samples per pixel, against the reference.
+PATH_TRACING_SPP = (1, 2, 4, 8, 16, 32, 64)
+#: The seed of the curve's renders (the reference's seeds are 0, 1).
+CURVE_SEED = 7
+
+
+def path_tracing_curve(twin, reference, spps, folder, runs=1, log=print):
+    """The twin path traced at each of ``spps`` (seed ``CURVE_SEED``, not the reference's) against the reference
+    (``render_reference``): [{"spp", "errors": per object and "all", "seconds": the median of ``runs``}]."""
+    out = []
+    for spp in spps:
+        times = []
+        for _ in range(max(1, int(runs))):
+            image, _, seconds = render_measurement(twin, reference["resolution"], spp, CURVE_SEED, folder)
+            times.append(seconds)
+        errors = sphere_errors(image, reference["shadowed"], reference["index"], reference["names"])
+        out.append({"spp": spp, "errors": errors, "seconds": float(np.median(times)), "runs": times})
+        log(f"[concave] path traced at {spp} spp: median {errors['all']['median']:.1%}, p90 {errors['all']['p90']:.1%}, "
+            f"{out[-1]['seconds']:.2f} s")
+    return out
+
+
+def _concave_row(scene, twin, row, reference, runs, log):
+    """One row of the concave study measured against the shared reference."""
+    from ...core.materials.rt_lit_interface import Features
+
+    features = Features(**row.get("features", {}))
+    result = compare(scene, twin, tuple(reference["resolution"]), reference["samples"], tuple(reference["seeds"]),
+                     eevee=False, log=log, rt_lit_samples=rt_lit_samples_for(features), reference=reference, runs=runs)
+    without = result["without_shadows"]
+    return {"features": row.get("features", {}), "light_shadows": row.get("light_shadows"),
+            "label": features.label(), "rt_lit_samples": rt_lit_samples_for(features),
+            "errors": result["with_shadows"], "errors_unshadowed_twin": without["all"] if without else None,
+            "seconds": result["seconds"]["rt_lit_cycles"], "runs": result["seconds"]["rt_lit_runs"],
+            "shadowed_fraction": result.get("shadowed_fraction"), "images": result["images"]}
+
+
+def concave_study(rows, lut_dir=None, resolution=(256, 192), samples=64, seeds=(0, 1), curve_spps=PATH_TRACING_SPP,
+                  runs=1, log=print, lights=True, world=True):
+    """The concave scene (``lookdev_scene.new_concave_scene``) against its twin, one row per entry of ``rows``
+    ({"features": keyword arguments of ``Features``, "light_shadows": None or those of ``shadows.enable_shadows``}):
+    each row built afresh (``study_scene``) and its RT Lit render (``runs`` times) measured over every RT Lit
+    object's pixels against ONE reference, the twin at ``samples`` spp x ``seeds``, rendered with the first row's
+    twin, which also renders path tracing's own curve (``path_tracing_curve``, ``curve_spps``; none when empty).
+    ``lights``: False removes the studio lights (the world alone); ``world``: False leaves the world out (the lights
+    alone).  Returns {"reference": its settings, noise and seconds, "rows": [...], "path_tracing": [...]}; each row
+    keeps its images (not JSON)."""
+    from ...addon import lookdev_scene
+    from ...core.materials.rt_lit_interface import Features
+
+    reference, curve, out = None, [], []
+    with tempfile.TemporaryDirectory(prefix="rtl-concave-") as tmp:
+        for row in rows:
+            features = Features(**row.get("features", {}))
+            scene, twin = study_scene(lambda: lookdev_scene.new_concave_scene(
+                "Concave Study", features, hdri=lookdev_scene.DEFAULT_HDRI if world else None, view_transform="Standard",
+                lut_dir=lut_dir, resolution=resolution), lut_dir, lights, row.get("light_shadows"))
+            if reference is None:
+                reference = render_reference(twin, number_objects(scene, twin), resolution, samples, seeds, tmp, log)
+                curve = path_tracing_curve(twin, reference, curve_spps, tmp, runs, log)
+            out.append(_concave_row(scene, twin, row, reference, runs, log))
+            e = out[-1]["errors"]["all"]
+            log(f"[concave] {out[-1]['label']}, light shadows {row.get('light_shadows')}: median {e['median']:.1%}, "
+                f"p90 {e['p90']:.1%}, {out[-1]['seconds']:.2f} s")
+    return {"reference": {"samples": samples, "seeds": list(seeds), "resolution": list(resolution),
+                          "objects": reference["names"], "seconds": reference["seconds"],
+                          "noise_median": out[0]["errors"]["all"]["noise_median"] if out else None},
+            "rows": out, "path_tracing": curve}
 
 
 def run(out_dir, lut_dir=None, resolution=(320, 160), samples=256, eevee=True, pictures_dir=None, log=print):
