@@ -1,6 +1,6 @@
 """The asset-like concave scene of issue 29 (``lookdev_scene.new_concave_scene``): it builds, its twin copies every
 RT Lit object, and the shadows (world occlusion and the lights' ratio estimator) bring RT Lit nearer the path-traced
-twin on it (``lookdev_twin.concave_study``, at a test's size)."""
+twin on it (``shadow_studies.concave_study``, at a test's size)."""
 from __future__ import annotations
 
 import numpy as np
@@ -37,10 +37,10 @@ def test_shadows_lower_the_error_on_the_concave_scene(bpy_module, lut_dir):
     """Unshadowed RT Lit against the default shadows (the lights' and the World term's, 4 probe samples with OIDN),
     both measured against one twin reference over every RT Lit object's pixels."""
     from rt_lookdev.validation.benchmarks import concave_shadows_benchmark as benchmark
-    from rt_lookdev.validation.checks import lookdev_twin
+    from rt_lookdev.validation.checks import shadow_studies
 
-    study = lookdev_twin.concave_study(benchmark.QUICK_ROWS, lut_dir, RESOLUTION, samples=8, curve_spps=(2,),
-                                       log=print)
+    study = shadow_studies.concave_study(benchmark.QUICK_ROWS, lut_dir, RESOLUTION, samples=8, curve_spps=(2,),
+                                         log=print)
     without, with_shadows = (row["errors"]["all"] for row in study["rows"])
     print(without, with_shadows)
     assert with_shadows["values"] > 1000 and with_shadows["values"] == without["values"]

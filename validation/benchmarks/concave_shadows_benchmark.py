@@ -4,7 +4,7 @@ time-vs-error curve.
     python scripts/benchmark_concave_shadows.py [--out docs/benchmarks] [--quick] [--runs N]
 
 The concave scene (``lookdev_scene.new_concave_scene``: a torus resting on the floor of an open box, a copper
-Suzanne beside it, the studio lights and HDRI world) measured by ``lookdev_twin.concave_study``: one row per RT Lit
+Suzanne beside it, the studio lights and HDRI world) measured by ``shadow_studies.concave_study``: one row per RT Lit
 setting (unshadowed; world occlusion; the lights' shadows by the ratio estimator of addon/shadows.py at 1 ... 64
 probe samples per pixel with Open Image Denoise, world occlusion on), each against ONE reference, the twin path
 traced at ``--samples`` spp x 2 seeds.  Per row: the per-value relative error (the validation's metric) over every
@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import lookdev_twin
+from ..checks import lookdev_twin, shadow_studies
 from ..harness import entry, outputs, png
 
 REPO = Path(__file__).resolve().parents[2]
@@ -50,7 +50,7 @@ SPLIT = (("lights_only", "The studio lights alone (no world)", {"world": False},
          ("world_only", "The world alone (the studio lights removed)", {"lights": False},
           (UNSHADOWED, OCCLUDED, {"features": {}, "light_shadows": dict(DEFAULT_SHADOWS)})))
 #: (resolution, reference spp, path tracing's curve) of the full run and of ``--quick``.
-FULL = ((256, 192), 64, lookdev_twin.PATH_TRACING_SPP)
+FULL = ((256, 192), 64, shadow_studies.PATH_TRACING_SPP)
 QUICK = ((64, 48), 8, (1, 4))
 
 
@@ -115,7 +115,7 @@ def run(args, progress=entry.flush_log):
     samples = args.samples or samples
     rows = QUICK_ROWS if args.quick else ROWS
     runs = args.runs if args.runs is not None else (1 if args.quick else 3)
-    study = lookdev_twin.concave_study(rows, args.lut_dir, resolution, samples, curve_spps=spps, runs=runs,
+    study = shadow_studies.concave_study(rows, args.lut_dir, resolution, samples, curve_spps=spps, runs=runs,
                                        log=progress)
     curve = study["path_tracing"]
     result = {"machine": platform.processor() or platform.machine(), "quick": args.quick, "runs": runs,
@@ -132,7 +132,7 @@ def _split(args, resolution, samples, progress):
     """{key: {"title", "reference", "rows"}} of the lights alone and the world alone (``SPLIT``)."""
     out = {}
     for key, title, options, rows in SPLIT:
-        study = lookdev_twin.concave_study(rows, args.lut_dir, resolution, samples, curve_spps=(), runs=1,
+        study = shadow_studies.concave_study(rows, args.lut_dir, resolution, samples, curve_spps=(), runs=1,
                                            log=progress, **options)
         out[key] = {"title": title, "reference": study["reference"],
                     "rows": [_row_record(r, []) for r in study["rows"]]}

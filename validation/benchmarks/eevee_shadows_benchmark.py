@@ -2,7 +2,7 @@
 
     python scripts/benchmark_eevee_shadows.py [--out docs/benchmarks] [--quick]
 
-On each scene of ``lookdev_twin.EEVEE_STUDY_SCENES`` (the floor study, the concave scene), ``Features()``, the
+On each scene of ``shadow_studies.EEVEE_STUDY_SCENES`` (the floor study, the concave scene), ``Features()``, the
 studio lights and world: EEVEE F12 with shadows against Cycles F12 with shadows (the lights' ratio estimator,
 ``world=False``, since EEVEE does not shadow the World term), and the same without shadows for reference; the
 per-pixel relative error (the validation's metric), median / p90, over every RT Lit object and per region, and each
@@ -14,13 +14,13 @@ import argparse
 import platform
 from pathlib import Path
 
-from ..checks import lookdev_twin
+from ..checks import shadow_studies
 from ..harness import entry, outputs
 
 REPO = Path(__file__).resolve().parents[2]
 
 #: (resolution, EEVEE samples, scenes) of the full run and of ``--quick``.
-FULL = ((160, 100), 16, lookdev_twin.EEVEE_STUDY_SCENES)
+FULL = ((160, 100), 16, shadow_studies.EEVEE_STUDY_SCENES)
 QUICK = ((48, 30), 2, ("floor",))
 
 
@@ -30,7 +30,7 @@ def run(args, progress=entry.flush_log):
     result = {"machine": platform.processor() or platform.machine(), "resolution": list(resolution),
               "eevee_samples": samples, "quick": args.quick, "scenes": []}
     for kind in scenes:
-        study = lookdev_twin.eevee_shadow_study(args.lut_dir, resolution, samples, log=progress, scene_kind=kind)
+        study = shadow_studies.eevee_shadow_study(args.lut_dir, resolution, samples, log=progress, scene_kind=kind)
         study.pop("images")
         result["scenes"].append(study)
     outputs.write_results(args.out, "eevee_shadows", result, to_markdown(result))
