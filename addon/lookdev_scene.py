@@ -212,6 +212,31 @@ def _floor(name, collection, z, lut_dir, scene, occlusion="none"):
     return obj
 
 
+def studio_scene(name, hdri, world_strength, view_transform, resolution, advance=None):
+    """A new scene of the current file set up as the lookdev scenes are: the lookdev render settings, the studio HDRI
+    ``hdri`` (None: no world) synced as RT Lit's World term, the studio lights synced; ``advance()`` is called after
+    the world and after the lights (progress)."""
+    from . import materials
+    from . import world_sync as rtl_world
+
+    scene = bpy.data.scenes.new(name)
+    configure_lookdev_render(scene, view_transform)
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
+    scene.world = None
+    if hdri is not None:
+        world = add_hdri_world(scene, hdri, world_strength, name=f"{name} {hdri}")
+        world.cycles.sampling_method = "AUTOMATIC"   # the twin path-traces this world
+    rtl_world.sync_world(scene)          # bakes (cached) the HDRI; no usable image: no World term
+    if advance is not None:
+        advance()
+    _studio_lights(scene.collection)
+    materials.sync_scene_lights(scene)   # lights first: the RT Lit groups are built for them
+    if advance is not None:
+        advance()
+    return scene
+
+
 def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world_strength=1.0,
                       view_transform="AgX", lut_dir=None, resolution=(960, 480), progress=None, floor=False):
     """Build the lookdev scene (see the module doc) as a new scene of the current file; returns it.
@@ -219,10 +244,9 @@ def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world
     ``features``: the RT Lit switches (``Features``; default ``Features()``); ``hdri``: a studio HDRI name
     (``core.environment.equirect.studio_hdris``) or an EXR path, None for no world; ``progress(done,
     total)`` is called after each step (the world bake, each material); ``floor``: a grey RT Lit floor under
-    the spheres, and the camera tilted to see it (RT Lit casts no shadows on it: README, "Limits")."""
+    the spheres, and the camera tilted to see it (shadowed only with RT Lit Shadows on: addon/shadows.py)."""
     from ..core.materials.rt_lit_interface import Features
     from . import convert, materials
-    from . import world_sync as rtl_world
 
     features = features or Features()
     total = 2 + len(ROWS) * len(ROUGHNESS)
@@ -233,21 +257,8 @@ def new_lookdev_scene(name="RT Lookdev", features=None, hdri=DEFAULT_HDRI, world
         if progress is not None:
             progress(step[0], total)
 
-    scene = bpy.data.scenes.new(name)
-    configure_lookdev_render(scene, view_transform)
-    scene.render.resolution_x, scene.render.resolution_y = resolution
-    scene.render.resolution_percentage = 100
+    scene = studio_scene(name, hdri, world_strength, view_transform, resolution, advance)
     collection = scene.collection
-    scene.world = None
-    if hdri is not None:
-        world = add_hdri_world(scene, hdri, world_strength, name=f"{name} {hdri}")
-        world.cycles.sampling_method = "AUTOMATIC"   # the twin path-traces this world
-    rtl_world.sync_world(scene)          # bakes (cached) the HDRI; no usable image: no World term
-    advance()
-
-    _studio_lights(collection)
-    materials.sync_scene_lights(scene)   # lights first: the RT Lit groups are built for them
-    advance()
 
     def factory(feats):
         return materials.ensure_rt_lit_group(feats, scene, lut_dir)
@@ -386,21 +397,10 @@ def new_concave_scene(name="RT Concave", features=None, hdri=DEFAULT_HDRI, world
     looking into the box from the front, above."""
     from ..core.materials.rt_lit_interface import Features
     from . import convert, materials
-    from . import world_sync as rtl_world
 
     features = features or Features()
-    scene = bpy.data.scenes.new(name)
-    configure_lookdev_render(scene, view_transform)
-    scene.render.resolution_x, scene.render.resolution_y = resolution
-    scene.render.resolution_percentage = 100
+    scene = studio_scene(name, hdri, world_strength, view_transform, resolution)
     collection = scene.collection
-    scene.world = None
-    if hdri is not None:
-        world = add_hdri_world(scene, hdri, world_strength, name=f"{name} {hdri}")
-        world.cycles.sampling_method = "AUTOMATIC"   # the twin path-traces this world
-    rtl_world.sync_world(scene)
-    _studio_lights(collection)
-    materials.sync_scene_lights(scene)
 
     def factory(feats):
         return materials.ensure_rt_lit_group(feats, scene, lut_dir)
