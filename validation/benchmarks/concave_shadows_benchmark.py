@@ -17,7 +17,6 @@ arguments of ``shadows.enable_shadows`` and its switches those of ``Features``. 
 """
 from __future__ import annotations
 
-import argparse
 import math
 import platform
 from pathlib import Path
@@ -151,8 +150,9 @@ def _split_markdown(split, names):
     for part in split.values():
         for row in part["rows"]:
             cells = [part["title"], row["features"].get("occlusion", "none"), shadows_label(row["light_shadows"]),
-                     _errors_cell(row["errors"]["all"])] + [_errors_cell(row["errors"].get(n)) for n in names]
-            cells += [_errors_cell(row["unshadowed_twin"]), f"{part['reference']['noise_median']:.1%}",
+                     outputs.median_p90(row["errors"]["all"])]
+            cells += [outputs.median_p90(row["errors"].get(n)) for n in names]
+            cells += [outputs.median_p90(row["unshadowed_twin"]), f"{part['reference']['noise_median']:.1%}",
                       f"{row['seconds']:.1f} s ({row['rt_lit_samples']} spp)"]
             lines.append("| " + " | ".join(cells) + " |")
     return lines + [""]
@@ -168,10 +168,6 @@ def _seconds_cell(record):
     shared: the fastest is the nearest to the render's own cost)."""
     runs = record.get("runs") or []
     return f"{record['seconds']:.1f} s" + (f" (min {min(runs):.1f})" if len(runs) > 1 else "")
-
-
-def _errors_cell(e):
-    return f"{e['median']:.1%} / {e['p90']:.1%}" if e and e.get("values") else "-"
 
 
 def to_markdown(result):
@@ -198,8 +194,8 @@ def to_markdown(result):
               "|---|---|---|" + "---|" * len(names) + "---|---|"]
     for row in result["rows"]:
         occlusion = row["features"].get("occlusion", "none")
-        cells = [occlusion, shadows_label(row["light_shadows"]), _errors_cell(row["errors"]["all"])]
-        cells += [_errors_cell(row["errors"].get(n)) for n in names]
+        cells = [occlusion, shadows_label(row["light_shadows"]), outputs.median_p90(row["errors"]["all"])]
+        cells += [outputs.median_p90(row["errors"].get(n)) for n in names]
         cells += [f"{_seconds_cell(row)}, {row['rt_lit_samples']} spp",
                   _equal_error_cell(result["path_tracing"], row["errors"]["all"]["median"])]
         lines.append("| " + " | ".join(cells) + " |")
@@ -207,7 +203,7 @@ def to_markdown(result):
     lines.append("")
     if plain is not None and plain["unshadowed_twin"]:
         lines.append(f"Unshadowed RT Lit against the twin with its objects seen by camera rays only (no shadow, no "
-                     f"occlusion of the world): {_errors_cell(plain['unshadowed_twin'])}, the error of the shading "
+                     f"occlusion of the world): {outputs.median_p90(plain['unshadowed_twin'])}, the error of the shading "
                      "itself, which shadows cannot remove.")
     lines += [f"The reference's own noise (median of its two seeds' half-difference): {ref['noise_median']:.1%}; "
               f"its renders took {', '.join(f'{s:.1f}' for s in ref['seconds'])} s.", ""]
@@ -219,8 +215,8 @@ def to_markdown(result):
                   "| spp | all objects | " + " | ".join(_short(n) for n in names) + " | path tracing render |",
                   "|---|---|" + "---|" * len(names) + "---|"]
         for point in result["path_tracing"]:
-            cells = [str(point["spp"]), _errors_cell(point["errors"]["all"])]
-            cells += [_errors_cell(point["errors"].get(n)) for n in names] + [_seconds_cell(point)]
+            cells = [str(point["spp"]), outputs.median_p90(point["errors"]["all"])]
+            cells += [outputs.median_p90(point["errors"].get(n)) for n in names] + [_seconds_cell(point)]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     if result.get("split"):
@@ -231,10 +227,7 @@ def to_markdown(result):
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks")
-    p.add_argument("--lut-dir", type=Path, default=None, help="LUT folder (default: the extension's luts/)")
-    p.add_argument("--quick", action="store_true", help="64 x 48, the reference at 8 spp, two rows (smoke run)")
+    p = entry.benchmark_parser(__doc__, REPO / "docs" / "benchmarks", "64 x 48, the reference at 8 spp, two rows (smoke run)")
     p.add_argument("--samples", type=int, default=None, help="the reference's spp per seed (default 64; --quick 8)")
     p.add_argument("--runs", type=int, default=None, help="RT Lit and path tracing renders per row, the median "
                                                           "timed (default 3; --quick 1)")

@@ -10,7 +10,6 @@ render's seconds (one run).  Writes ``eevee_shadows.md`` and ``.json`` in ``--ou
 """
 from __future__ import annotations
 
-import argparse
 import platform
 from pathlib import Path
 
@@ -37,10 +36,6 @@ def run(args, progress=entry.flush_log):
     return result
 
 
-def _cell(stats):
-    return f"{stats['median']:.2%} / {stats['p90']:.2%}" if stats.get("values") else "-"
-
-
 def to_markdown(result):
     lines = ["# RT Lit shadows: EEVEE against Cycles", "",
              "Written by `python scripts/benchmark_eevee_shadows.py` (validation/benchmarks/eevee_shadows_benchmark.py;"
@@ -52,17 +47,15 @@ def to_markdown(result):
     for study in result["scenes"]:
         seconds = study["seconds"]
         lines += [f"## The {study['scene']} scene", "", "| region | with shadows | without shadows |", "|---|---|---|"]
-        lines += [f"| {region} | {_cell(cases['shadows'])} | {_cell(cases['no_shadows'])} |"
-                  for region, cases in study["regions"].items()]
-        lines += ["", f"The shadows change Cycles' render by {_cell(study['cycles_shadows_vs_cycles'])} (all RT Lit "
+        lines += [f"| {region} | {outputs.median_p90(cases['shadows'], 2)} | "
+                  f"{outputs.median_p90(cases['no_shadows'], 2)} |" for region, cases in study["regions"].items()]
+        change = outputs.median_p90(study["cycles_shadows_vs_cycles"], 2)
+        lines += ["", f"The shadows change Cycles' render by {change} (all RT Lit "
                   "pixels: the size of what is compared).  F12 seconds, one run each on a shared machine: "
                   + ", ".join(f"{k} {v:.1f}" for k, v in seconds.items()) + ".", ""]
     return "\n".join(lines)
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks")
-    p.add_argument("--lut-dir", type=Path, default=None, help="LUT folder (default: the extension's luts/)")
-    p.add_argument("--quick", action="store_true", help="the floor study only, 48 x 30, 2 EEVEE samples (smoke run)")
+    p = entry.benchmark_parser(__doc__, REPO / "docs" / "benchmarks", "the floor study only, 48 x 30, 2 EEVEE samples (smoke run)")
     return p.parse_args(argv)

@@ -13,7 +13,6 @@ term's own error.  Writes ``floor_shadows.md`` and ``.json`` in ``--out``.
 """
 from __future__ import annotations
 
-import argparse
 import platform
 from pathlib import Path
 
@@ -114,7 +113,8 @@ def to_markdown(result):
                          if vis else "- | -")
             lines.append(f"| {row_label(row['occlusion'], row['light_shadows'], row['section'])} | {row['median']:.1%} / "
                          f"{row['p90']:.1%} | {row['darkened_median']:.1%} / {row['darkened_p90']:.1%} | "
-                         f"{_cell(row['spheres']['all'])} | {_cell(row['spheres']['glossy'])} | {vis_cells} | "
+                         f"{outputs.median_p90(row['spheres']['all'])} | "
+                         f"{outputs.median_p90(row['spheres']['glossy'])} | {vis_cells} | "
                          f"{row['rt_lit_seconds']:.1f} s ({row['rt_lit_samples']} spp) |")
         unshadowed = next((r["floor_unshadowed_twin_median"] for r in result["rows"]
                            if r["section"] == section and r["occlusion"] == "none" and r["light_shadows"] is None), None)
@@ -145,13 +145,6 @@ def _per_sphere(rows):
     return lines + [""]
 
 
-def _cell(stats):
-    return f"{stats['median']:.1%} / {stats['p90']:.1%}" if stats.get("values") else "-"
-
-
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks")
-    p.add_argument("--lut-dir", type=Path, default=None, help="LUT folder (default: the extension's luts/)")
-    p.add_argument("--quick", action="store_true", help="96 x 60, 8 spp, four rows (smoke run)")
+    p = entry.benchmark_parser(__doc__, REPO / "docs" / "benchmarks", "96 x 60, 8 spp, four rows (smoke run)")
     return p.parse_args(argv)

@@ -19,6 +19,9 @@ A check (validation/checks/) or benchmark (validation/benchmarks/) module define
 """
 from __future__ import annotations
 
+import argparse
+from pathlib import Path
+
 
 def flush_log(line):
     """The default ``progress`` of long runs: print at once (progress shows while a job runs)."""
@@ -34,6 +37,16 @@ def script_arguments(argv):
     scripts/validate.py -- options``), else ``argv``."""
     argv = list(argv)
     return argv[argv.index("--") + 1:] if "--" in argv else argv
+
+
+def benchmark_parser(doc, out, quick_help):
+    """The parser most benchmarks start from: the module docstring's first paragraph as its description, ``--out``
+    (default ``out``), ``--lut-dir`` and ``--quick`` (``quick_help`` says what it cuts)."""
+    p = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    p.add_argument("--out", type=Path, default=out)
+    p.add_argument("--lut-dir", type=Path, default=None, help="LUT folder (default: the extension's luts/)")
+    p.add_argument("--quick", action="store_true", help=quick_help)
+    return p
 
 
 def exit_code(result):

@@ -89,6 +89,13 @@ def percent(x, digits=2):
     return "-" if x is None else f"{100 * x:.{digits}f}%"
 
 
+def median_p90(stats, digits=1):
+    """"median / p90" of an error summary ({"values", "median", "p90"}) as percentages; "-" when it has no value."""
+    if not stats or not stats.get("values"):
+        return "-"
+    return f"{percent(stats['median'], digits)} / {percent(stats['p90'], digits)}"
+
+
 def scientific(x):
     """``x`` in scientific notation, 3 significant digits; "-" for None."""
     return "-" if x is None else f"{x:.2e}"
