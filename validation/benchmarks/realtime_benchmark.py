@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ...core.export import scene as scene_io
+from ...core.lights import SHADING_POINT_INPUTS, light_data
 from ...core.lut import catalog, exr_io
 from ...core.materials import rt_lit
 from ...core.materials.rt_lit_interface import Features, LIGHT_KINDS
@@ -64,7 +65,7 @@ def uv_sphere(radius=1.0, segments=64, rings=32):
     return normals * radius, normals
 
 
-def _light(kind, k, count):
+def light_parameters(kind, k, count):
     """Driver parameters of the ``k``-th of ``count`` lights: spread on a ring in front of the sphere,
     aimed at its centre."""
     angle = 2.0 * np.pi * (k + 0.5) / count
@@ -75,21 +76,20 @@ def _light(kind, k, count):
     x = x / np.linalg.norm(x) if np.linalg.norm(x) > 1e-9 else np.array([1.0, 0.0, 0.0])
     y = np.cross(z, x)
     w, qx, qy, qz = _quaternion(np.stack([x, y, z], axis=1))
-    params = {"Rotation W": w, "Rotation X": qx, "Rotation Y": qy, "Rotation Z": qz,
-              "Color R": 1.0, "Color G": 0.9, "Color B": 0.8, "Exposure": 0.0, "Normalize": 1.0}
-    if kind != "sun":
-        params.update({"Location X": loc[0], "Location Y": loc[1], "Location Z": loc[2]})
-    if kind in ("quad", "disk", "spot", "sun"):
-        params.update({"Scale X": 1.0, "Scale Y": 1.0, "Scale Z": 1.0, "Determinant": 1.0})
-    if kind in ("quad", "disk"):
-        params.update({"Power": 200.0, "Size": 1.0, "Size Y": 0.6})
-    elif kind == "point":
-        params["Power"] = 100.0
-    elif kind == "spot":
-        params.update({"Power": 300.0, "Spot Size": 1.0, "Spot Blend": 0.3})
-    else:
-        params["Strength"] = 1.0
-    return {k: float(v) for k, v in params.items()}
+    values = dict(_LIGHT_SETTINGS, **{"Rotation W": w, "Rotation X": qx, "Rotation Y": qy, "Rotation Z": qz,
+                                     "Location X": loc[0], "Location Y": loc[1], "Location Z": loc[2],
+                                     "Power": _LIGHT_POWER.get(kind, 100.0)})
+    return {param: float(values[param]) for param in light_data(kind).input_sockets
+            if param not in SHADING_POINT_INPUTS}
+
+
+#: The driver values every light of the benchmark shares (a light kind takes those its driver has).
+_LIGHT_SETTINGS = {"Color R": 1.0, "Color G": 0.9, "Color B": 0.8, "Exposure": 0.0, "Normalize": 1.0, "Scale X": 1.0,
+                   "Scale Y": 1.0, "Scale Z": 1.0, "Determinant": 1.0, "Size": 1.0, "Size Y": 0.6, "Spot Size": 1.0,
+                   "Spot Blend": 0.3, "Strength": 1.0, "Radius": 0.1, "Soft Falloff": 1.0,
+                   "Angle": float(np.radians(0.526)), "Cone Inner": float(np.radians(90.0)),
+                   "Cone Outer": float(np.radians(100.0))}
+_LIGHT_POWER = {"quad": 200.0, "disk": 200.0, "spot": 300.0, "spot_sphere": 300.0}
 
 
 def _quaternion(m):
@@ -109,7 +109,7 @@ def _quaternion(m):
 
 
 def light_kinds(count):
-    """1: a quad; 4: quad, disk, point, spot; otherwise the five kinds in turn."""
+    """1: a quad; 4: quad, disk, point, spot; otherwise every light kind in turn but the quad-to-spot fallback."""
     if count == 1:
         return ("quad",)
     if count == 4:
@@ -129,7 +129,7 @@ def write_scene(folder, features, world, count, resolution, lut_dir):
     matrix = [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, -1.0, -5.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
     camera = scene_io.Camera(matrix, "ORTHO", 2.0 * half_w, clip_start=0.1, clip_end=20.0, resolution=(w, h))
     kinds = light_kinds(count)
-    lights = [scene_io.SceneLight(f"{kind} {k}", kind, _light(kind, k, count)) for k, kind in enumerate(kinds)]
+    lights = [scene_io.SceneLight(f"{kind} {k}", kind, light_parameters(kind, k, count)) for k, kind in enumerate(kinds)]
     table_files, tables, world_desc = {}, {}, None
     env = None
     if world:
