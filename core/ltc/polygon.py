@@ -349,33 +349,20 @@ def ltc_polygon_vector_form_factor(minv, corners):
 # --- horizon clipping, traceable (exact for lobes that live near the horizon) --------------------
 
 # Heitz et al. 2016 (ltc_code ``ltc_quad.fs``, its clipped branch ``ClipQuadToHorizon``), written without
-# branches as ``clip_to_horizon`` above (Sutherland & Hodgman 1974 against z = 0): every edge keeps its part
-# with z >= 0 as a (start, end) pair; an edge entirely below collapses onto the polygon's exit point (where
-# it leaves the upper half-space: a convex polygon has at most one), so the 2K points are the closed clipped
-# polygon with repeated points, whose zero-length edges add nothing.
+# branches (Sutherland & Hodgman 1974 against z = 0).  The clipped polygon's boundary is every edge's part above
+# the horizon plus one arc along the horizon, from where the polygon leaves the upper half-space (the exit point)
+# to where it comes back (the entry point): a convex polygon crosses z = 0 at most twice.  So its form factor is
+# one arc per edge (zero for an edge wholly below) and one closing arc (zero when nothing crosses: both points
+# are then 0), streamed edge by edge in one pass so that only the K corners and four running sums stay live
+# (Cycles' SVM stack: a 12-gon's 24 clipped points held at once overflowed it in Blender 4.5).
 def _horizon_crossing(a, b):
-    """(point of the segment a-b on z = 0 (z set to exactly 0), a above, b above, a leaves: 0/1 floats)."""
+    """(point of the segment a-b on z = 0 (z set to exactly 0), a above, b above: 0/1 floats)."""
     za, zb = op.component(a, 2), op.component(b, 2)
     above_a, above_b = 1.0 - op.less(za, 0.0), 1.0 - op.less(zb, 0.0)
     crossing = above_a + above_b - 2.0 * above_a * above_b
     t = op.safe_div(za, op.select(crossing, za - zb, 1.0))
     x = a + op.scale(b - a, t)
-    return op.vec3(op.component(x, 0), op.component(x, 1), 0.0 * za), above_a, above_b, above_a * (1.0 - above_b)
-
-
-def _clip_edge(**kw):
-    x, above_a, above_b, leaves = _horizon_crossing(kw["A"], kw["B"])
-    return {"Crossing": x, "A Above": above_a, "B Above": above_b, "Leaves": leaves}
-
-
-_HORIZON_EDGE = NodeFunction(
-    "RTL Horizon Edge", _clip_edge,
-    {"A": vector("Edge start (transformed, local frame)", "XYZ"), "B": vector("Edge end", "XYZ")},
-    {"Crossing": vector("Where the edge meets z = 0 (when it does)", "XYZ"),
-     "A Above": Socket("float", 0.0, description="1 where A.z >= 0"),
-     "B Above": Socket("float", 0.0, description="1 where B.z >= 0"),
-     "Leaves": Socket("float", 0.0, description="1 where the edge goes from above to below the horizon")},
-    "One edge of a polygon against the horizon z = 0 (Sutherland-Hodgman)")
+    return op.vec3(op.component(x, 0), op.component(x, 1), 0.0 * za), above_a, above_b
 
 
 def _cross_z(a, b):
@@ -389,73 +376,56 @@ def _arc_terms(a, b, o):
     return _cross_z(a - o, b - o) * w, op.scale(b - a, w)
 
 
-def _clip_point(above, point, other_above, crossing, exit_point):
-    """An edge end after clipping: the point itself when above; else the edge's crossing when the edge's other
-    end is above; else (the whole edge below) the polygon's exit point."""
-    return op.vselect(above, point, op.vselect(other_above, crossing, exit_point))
+def clipped_edge_terms(a, b, origin):
+    """{"Area", "Flow"}: the terms of the part of the edge a -> b above the horizon (zero for an edge wholly
+    below) in ``clipped_form_factor_z``'s sum about ``origin`` (a point near the polygon, not normalised);
+    {"Exit Part", "Entry Part"}: the edge's crossing where it leaves (enters) the upper half-space, else 0."""
+    x, above_a, above_b = _horizon_crossing(a, b)
+    # an end below the horizon moves to the crossing; an edge wholly below becomes the arc x -> x, exactly zero
+    start = op.normalize(op.vselect(above_a, a, x))
+    end = op.normalize(op.vselect(above_b, b, x))
+    area, flow = _arc_terms(start, end, op.normalize(origin))
+    return {"Area": area, "Flow": flow, "Exit Part": op.scale(x, above_a * (1.0 - above_b)),
+            "Entry Part": op.scale(x, above_b * (1.0 - above_a))}
 
 
-# One edge (A -> B) of the clipped polygon and the connection to the next edge's start (B -> C's clipped part),
-# summed as two arcs of the form factor: the clipped polygon streams edge by edge (2K arcs, repeated points adding
-# nothing), so only the K corners stay live (Cycles' SVM stack: a 12-gon's 24 clipped points held at once
-# overflowed it in Blender 4.5).
-def clipped_edge_terms(a, b, c, exit_point, origin):
-    """{"Area", "Flow"} of the edge a -> b clipped at the horizon plus the arc to the clipped start of b -> c
-    (``clipped_form_factor_z``); ``origin`` a point of the clipped polygon (not normalised)."""
+def clipped_sum_z(area, flow, exit_point, entry_point, origin):
+    """z of the clipped polygon's vector form factor from its edges' summed terms: the closing arc from the exit
+    point to the entry point along the horizon added, then the origin's part o x flow."""
     o = op.normalize(origin)
-    x_ab, above_a, above_b, _ = _horizon_crossing(a, b)
-    x_bc, _, above_c, _ = _horizon_crossing(b, c)
-    start = op.normalize(_clip_point(above_a, a, above_b, x_ab, exit_point))
-    end = op.normalize(_clip_point(above_b, b, above_a, x_ab, exit_point))
-    following = op.normalize(_clip_point(above_b, b, above_c, x_bc, exit_point))
-    area1, flow1 = _arc_terms(start, end, o)
-    area2, flow2 = _arc_terms(end, following, o)
-    return {"Area": area1 + area2, "Flow": flow1 + flow2}
-
-
-def exit_part(a, b):
-    """The edge a -> b's share of the polygon's exit point: its crossing where it leaves the upper half-space
-    (a convex polygon has at most one such edge), else 0."""
-    x, _, _, leaves = _horizon_crossing(a, b)
-    return op.scale(x, leaves)
-
-
-def clipped_origin(a, b, exit_point):
-    """The clipped start of the edge a -> b: a point of the clipped polygon (the form factor sum's origin)."""
-    x, above_a, above_b, _ = _horizon_crossing(a, b)
-    return _clip_point(above_a, a, above_b, x, exit_point)
+    closing_area, closing_flow = _arc_terms(op.normalize(exit_point), op.normalize(entry_point), o)
+    return area + closing_area + _cross_z(o, flow + closing_flow)
 
 
 def _clipped_edge(**kw):
-    return clipped_edge_terms(kw["A"], kw["B"], kw["C"], kw["Exit"], kw["O"])
+    return clipped_edge_terms(kw["A"], kw["B"], kw["O"])
 
+
+#: Outputs of one clipped edge's group (``clipped_edge_terms``).
+CLIPPED_EDGE_SOCKETS = {
+    "Area": Socket("float", 0.0, description="z of w (a - o) x (b - o) over the edge's part above the horizon"),
+    "Flow": vector("w (b - a) over the edge's part above the horizon", "XYZ"),
+    "Exit Part": vector("The edge's crossing where it leaves the upper half-space, else 0", "XYZ"),
+    "Entry Part": vector("The edge's crossing where it enters the upper half-space, else 0", "XYZ")}
 
 _CLIPPED_EDGE = NodeFunction(
     "RTL Clipped Edge", _clipped_edge,
     {"A": vector("Edge start (transformed, local frame)", "XYZ"), "B": vector("Edge end", "XYZ"),
-     "C": vector("The next edge's end", "XYZ"), "Exit": vector("Where the polygon leaves the upper half-space",
-                                                              "XYZ"),
-     "O": vector("A point of the clipped polygon (normalised inside): the sum's origin", "XYZ")},
-    {"Area": Socket("float", 0.0, description="z of sum w (a - o) x (b - o) over the edge's two arcs"),
-     "Flow": vector("sum w (b - a) over the edge's two arcs", "XYZ")},
-    "One edge of a polygon clipped at the horizon (Sutherland-Hodgman) in Arvo's form factor, with the arc to "
-    "the next edge's clipped start")
+     "O": vector("A point near the polygon (normalised inside): the sum's origin", "XYZ")},
+    CLIPPED_EDGE_SOCKETS,
+    "One edge of a polygon clipped at the horizon (Sutherland-Hodgman) in Arvo's form factor")
 
 
 def clipped_form_factor_z(points):
     """z of the vector form factor (fitted edges) of the convex polygon ``points`` (K vectors, transformed,
-    local frame, not normalised) clipped at z = 0: ``clip_to_horizon``'s closed sequence (every edge's part
-    above the horizon, an edge entirely below collapsed onto the exit point), summed as ``vector_form_factor``
-    does, one nested group per edge; traceable.  Negative seen from the polygon's back."""
+    local frame, not normalised) clipped at z = 0: every edge's part above the horizon and the closing arc along
+    it, summed as ``vector_form_factor`` does about the polygon's centroid, one nested group per edge; traceable.
+    Negative seen from the polygon's back."""
     pts = corner_vectors(points)
     k = len(pts)
-    edges = [_HORIZON_EDGE(A=pts[i], B=pts[(i + 1) % k]) for i in range(k)]
-    exit_point = _sum([op.scale(e["Crossing"], e["Leaves"]) for e in edges])
-    e0 = edges[0]
-    origin = _clip_point(e0["A Above"], pts[0], e0["B Above"], e0["Crossing"], exit_point)
-    terms = [_CLIPPED_EDGE(A=pts[i], B=pts[(i + 1) % k], C=pts[(i + 2) % k], Exit=exit_point, O=origin)
-             for i in range(k)]
-    return _sum([t["Area"] for t in terms]) + _cross_z(op.normalize(origin), _sum([t["Flow"] for t in terms]))
+    origin = op.scale(_sum(pts), 1.0 / k)
+    terms = [_CLIPPED_EDGE(A=pts[i], B=pts[(i + 1) % k], O=origin) for i in range(k)]
+    return clipped_sum_z(*(_sum([t[name] for t in terms]) for name in CLIPPED_EDGE_SOCKETS), origin)
 
 
 @functools.lru_cache(maxsize=None)
