@@ -88,17 +88,19 @@ class DiskLight:
         return fn(tables, **args)["Integral"]
 
 
-def lobe_integral(tables, prefix, light, p, n, v, roughness):
+def lobe_integral(tables, prefix, light, p, n, v, roughness, exact_horizon=False):
     """(LTC integral, magnitude, fresnel) of one table's lobe at this shading point (with its band, for a lobe
-    that has one: ``band_integral``)."""
+    that has one: ``band_integral``); ``exact_horizon``: the light clipped at the transformed horizon instead of
+    the sphere table's (``QuadLight.integral``)."""
     mu = op.saturate(op.dot(n, v))
     frame = polygon.local_frame(n, v)
     band = catalog.LTC_BANDS.get(prefix)
     if band is None:
         packed, magnitude, fresnel = tables.ltc(prefix, mu, roughness)
-        return light.integral(tables, packed, frame, p), magnitude, fresnel
+        return light.integral(tables, packed, frame, p, exact_horizon), magnitude, fresnel
     packed, magnitude, fresnel, weight = tables.ltc(prefix, mu, roughness, band_weight=True)
-    return band_integral(tables, light, packed, weight, band["squash"], frame, p), magnitude, fresnel
+    return (band_integral(tables, light, packed, weight, band["squash"], frame, p, exact_horizon), magnitude,
+            fresnel)
 
 
 # The band (this project's, issue 15; docs/area_lights.md, "The band"): the lobe is the mixture
@@ -110,11 +112,11 @@ def mix_band(main, band, weight):
     return main + op.saturate(weight) * (band - main)
 
 
-def band_integral(tables, light, packed, weight, squash, frame, p):
+def band_integral(tables, light, packed, weight, squash, frame, p, exact_horizon=False):
     """Integral of the LTC with packed entries ``packed`` mixed with its band (squash factor ``squash``) by
-    ``weight``, over the light, in the shading frame ``frame``."""
-    return mix_band(light.integral(tables, packed, frame, p),
-                    light.integral(tables, matrix.squash_packed(packed, squash), frame, p), weight)
+    ``weight``, over the light, in the shading frame ``frame``; ``exact_horizon`` as ``lobe_integral``."""
+    return mix_band(light.integral(tables, packed, frame, p, exact_horizon),
+                    light.integral(tables, matrix.squash_packed(packed, squash), frame, p, exact_horizon), weight)
 
 
 # Heitz et al. 2016 with Hill 2016's Fresnel split: int f cos F = F0 (mag - fres) + F90 fres.
@@ -186,10 +188,13 @@ def disney_sheen_fitted(tables, light, p, n, v, sheen_color):
     return magnitude * value * sheen_color
 
 
+# Lambert is the identity LTC (Heitz et al. 2016, section 5), so the polygon clipped at the horizon gives its exact
+# form factor.  The clipless form's sphere table is exact only above the horizon: under a quad crossing it the cap it
+# stands for is far from the clipped polygon (issue 30's minimal case: 0.00180 for 0.00034, +424%).
 def lambert(tables, light, p, n, v, albedo):
-    """Lambert: the identity LTC gives the exact form factor (Heitz et al. 2016, section 5); ``tables``
-    supplies only the sphere table."""
-    return light.integral(tables, IDENTITY, polygon.local_frame(n, v), p) * albedo
+    """Lambert's form factor of the light clipped exactly at the horizon (``exact_horizon``: the quad clipped,
+    the disk's closed form above the horizon and its clipped form where it crosses) times ``albedo``."""
+    return light.integral(tables, IDENTITY, polygon.local_frame(n, v), p, exact_horizon=True) * albedo
 
 
 def light_center(light):

@@ -141,7 +141,8 @@ KULLA_CONTY = Lobe("kulla_conty", "Kulla-Conty", ("Roughness",), _KC_OUT, _kulla
 
 
 # --- Lambert ----------------------------------------------------------------------------------------
-# max(N.L, 0) / pi; over an area light the identity LTC's exact form factor (Heitz et al. 2016, sec. 5).
+# max(N.L, 0) / pi; over an area light the identity LTC's form factor (Heitz et al. 2016, sec. 5) of the light
+# clipped at the horizon (``shading.lambert``: quads exact, disks by a 12-gon where they cross it).
 
 def _lambert_punctual(tables, N, V, L):
     mu_l = op.dot(N, L)
@@ -153,7 +154,7 @@ def _lambert_area(tables, light, Position, N, V):
 
 
 LAMBERT = Lobe("lambert", "Lambert", (), {"Diffuse": _OUT}, _lambert_punctual, _lambert_area,
-               "Lambert: max(N.L, 0) / pi", "Lambert form factor / albedo 1 (exact LTC)")
+               "Lambert: max(N.L, 0) / pi", "Lambert form factor / albedo 1 (identity LTC, clipped at the horizon)")
 
 
 # --- CoD WWII multiscattering diffuse (Chan 2018; the talk) ------------------------------------------

@@ -18,6 +18,7 @@ CONVERTED = {
     "checks/energy_render": "validate_energy.py",
     "checks/rough_diffuse_furnace": "validate_rough_diffuse.py",
     "benchmarks/environment_benchmark": "benchmark_environment.py",
+    "benchmarks/horizon_benchmark": "benchmark_horizon.py",
     "benchmarks/light_culling_benchmark": "benchmark_light_culling.py",
     "benchmarks/light_fallback_benchmark": "benchmark_light_fallback.py",
     "benchmarks/light_sync_benchmark": "benchmark_light_sync.py",

@@ -5,6 +5,7 @@ import pytest
 from rt_lookdev.core import cloth, diffuse, microfacet
 from rt_lookdev.core.ltc import reference, shading
 from rt_lookdev.core.lut import lookup
+from rt_lookdev.validation.benchmarks import horizon_benchmark
 
 P = np.zeros(3)
 N = np.array([0.0, 0.0, 1.0])
@@ -104,6 +105,41 @@ def test_lambert_is_the_exact_form_factor(ltc_tables):
     one = (a / np.sqrt(1 + a * a) * np.arctan(a / np.sqrt(1 + a * a))
            + a / np.sqrt(1 + a * a) * np.arctan(a / np.sqrt(1 + a * a))) / (2 * np.pi)
     assert got == pytest.approx(4 * one, rel=1e-5)
+
+
+# Issue 30's minimal case: a quad barely crossing the horizon.  The clipless form gave 0.00180 (+424%).
+MINIMAL_CROSSING_QUAD = np.array([[1.0, -0.5, -0.5], [1.0, 0.5, -0.5], [1.0, 0.5, 0.05], [1.0, -0.5, 0.05]])
+
+
+def lambert_cos(l, v):
+    return np.maximum(l[..., 2], 0.0) / np.pi
+
+
+@pytest.mark.parametrize("dtype, rel", [(np.float64, 1e-5), (np.float32, 1e-3)])
+def test_lambert_is_exact_under_a_quad_crossing_the_horizon(ltc_tables, dtype, rel):
+    exact = brute(lambert_cos, view(30), MINIMAL_CROSSING_QUAD)
+    assert exact == pytest.approx(3.4283e-4, rel=1e-4)            # the issue's figure, by quadrature
+    cast = lambda a: np.asarray(a, dtype=dtype)                  # noqa: E731
+    got = shading.lambert(ltc_tables, shading.QuadLight(cast(MINIMAL_CROSSING_QUAD)), cast(P), cast(N),
+                          cast(view(30)), dtype(1.0))
+    assert np.asarray(got).dtype == dtype
+    assert got == pytest.approx(exact, rel=rel)
+
+
+def test_lambert_under_random_lights_crossing_the_horizon(ltc_tables):
+    # the horizon benchmark's seeded lights (docs/benchmarks/horizon.md): quads exact to the edge formula's
+    # rounding; disks through the equal-area 12-gon clipped where they cross (measured there: median 2.5e-4,
+    # max 1e-2 over 120 disks), far from the clipless form's (median 1e-2, max 0.9)
+    for kind, median, worst in (("quad", 1e-5, 2e-4), ("disk", 2e-3, 3e-2)):
+        rel = []
+        for _, _, v, geom in horizon_benchmark.horizon_lights(kind, 16, True, seed=11):
+            exact = (reference.brdf_integral_polygon(lambert_cos, v, geom, panels=32) if kind == "quad"
+                     else reference.brdf_integral_disk(lambert_cos, v, *geom, panels=32)).value
+            if exact > 1e-6:
+                got = shading.lambert(ltc_tables, horizon_benchmark.shading_light(kind, geom), P, N, v, 1.0)
+                rel.append(abs(got / exact - 1.0))
+        assert len(rel) >= 12
+        assert np.median(rel) < median and max(rel) < worst, (kind, np.median(rel), max(rel))
 
 
 def test_wrapped_diffuse(ltc_tables):
