@@ -241,6 +241,13 @@ def _principled_input_used(material, name):
     return bool(socket.is_linked or socket.default_value > 0.0)
 
 
+#: What an exact area-light horizon costs in Blender 4.x (measured on 4.5: most feature sets overflow Cycles' SVM
+#: stack and render black; every set fits in 5.2; docs/area_lights.md, "RT Lit's exact horizon").
+EXACT_HORIZON_WARNING = ("Material '{material}': exact area-light horizons can overflow Cycles' shader stack in "
+                         "Blender 4.x (the material renders black there); Blender 5 fits them, or choose the Sphere "
+                         "Table horizon")
+
+
 def stored_features(material):
     """The features remembered on the material, or None."""
     data = material.get(FEATURES_KEY) if material is not None else None
@@ -251,7 +258,8 @@ def stored_features(material):
         features = Features.from_dict(data)
         return Features(specular=str(features.specular), diffuse=str(features.diffuse),
                         sheen=str(features.sheen), cloth=bool(features.cloth),
-                        environment_ms=str(features.environment_ms), occlusion=str(features.occlusion))
+                        environment_ms=str(features.environment_ms), occlusion=str(features.occlusion),
+                        horizon=str(features.horizon))
     except (TypeError, ValueError):
         return None
 
@@ -441,6 +449,8 @@ def principled_to_rt_lit(material, group_factory, features=None):
         amount = "a linked Diffuse Roughness" if rough.is_linked else f"Diffuse Roughness {rough.default_value:.3g}"
         result.warnings.append(f"Material '{material.name}': {amount} is not shaded by the '{features.diffuse}' "
                                "diffuse; convert again with the Oren-Nayar diffuse to keep it")
+    if features.horizon != "sphere_table" and bpy.app.version < (5, 0, 0):
+        result.warnings.append(EXACT_HORIZON_WARNING.format(material=material.name))
     if ignored:
         result.warnings.append(
             f"Material '{material.name}': RT Lit ignores the Principled inputs "

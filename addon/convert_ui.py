@@ -11,8 +11,8 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, OCCLUSION_MODELS, PRINCIPLED_SHEEN, SHEEN_MODELS,
-                                               SPECULAR_MODELS, Features)
+from ..core.materials.rt_lit_interface import (DIFFUSE_MODELS, HORIZON_MODELS, OCCLUSION_MODELS, PRINCIPLED_SHEEN,
+                                               SHEEN_MODELS, SPECULAR_MODELS, Features)
 from . import convert, preferences
 
 # --------------------------------------------------------------------------------------------
@@ -60,10 +60,22 @@ OCCLUSION_LABELS = {
 }
 OCCLUSION_ITEMS = tuple((m, *OCCLUSION_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in OCCLUSION_MODELS)
 
+HORIZON_LABELS = {
+    "sphere_table": ("Sphere Table (Talk)", "The talk's clipless form for every light: the cheapest, exact for lights "
+                     "wholly above the horizon, off by several times for lights that cross it"),
+    "exact_quads": ("Exact for Quads", "Quad lights clipped exactly at the surface's horizon, disk and sphere lights "
+                    "by the talk's sphere table (a quad costs about 1.8x the talk's nodes). Blender 5.x: in 4.5 most "
+                    "feature sets overflow Cycles' shader stack and render black"),
+    "exact": ("Exact", "Every area light clipped exactly at the surface's horizon: disks too, at about 5x the talk's "
+              "nodes per disk light. Blender 5.x: in 4.5 most feature sets overflow Cycles' shader stack"),
+}
+HORIZON_ITEMS = tuple((m, *HORIZON_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in HORIZON_MODELS)
+
 
 def draw_switches(layout, owner):
     """The RT Lit switches of ``owner`` (the Convert dialog, or a material's ``rtl_switches``): specular,
-    the world form (active for Fdez-Aguera), diffuse, sheen, cloth and the world's occlusion."""
+    the world form (active for Fdez-Aguera), diffuse, sheen, cloth, the world's occlusion and the area lights'
+    horizon."""
     layout.prop(owner, "specular")
     sub = layout.row()
     sub.active = owner.specular == 'fdez_aguera'
@@ -72,6 +84,9 @@ def draw_switches(layout, owner):
     layout.prop(owner, "sheen")
     layout.prop(owner, "cloth")
     layout.prop(owner, "occlusion")
+    layout.prop(owner, "horizon")
+    if owner.horizon != "sphere_table" and bpy.app.version < (5, 0, 0):
+        layout.label(text="Blender 4.x: may render black (shader stack)", icon='ERROR')
 
 
 # --------------------------------------------------------------------------------------------
@@ -161,6 +176,9 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
     occlusion: EnumProperty(name="World Occlusion",
                             description="How the scene occludes the world's light (Cycles' and EEVEE's Ambient "
                                         "Occlusion node feeds it)", items=OCCLUSION_ITEMS, default=Features().occlusion)
+    horizon: EnumProperty(name="Area Light Horizon",
+                          description="How the lobes meet the surface's horizon under area lights",
+                          items=HORIZON_ITEMS, default=Features().horizon)
 
     @classmethod
     def poll(cls, context):
@@ -171,7 +189,7 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
 
     def features(self):
         return Features(specular=self.specular, diffuse=self.diffuse, sheen=self.sheen, cloth=self.cloth,
-                        environment_ms=self.environment_ms, occlusion=self.occlusion)
+                        environment_ms=self.environment_ms, occlusion=self.occlusion, horizon=self.horizon)
 
     def invoke(self, context, event):
         material = _active_material(context)
@@ -180,6 +198,7 @@ class RTL_OT_convert_to_rt_lit(bpy.types.Operator):
             self.specular, self.diffuse = stored.specular, stored.diffuse
             self.sheen, self.cloth = stored.sheen, stored.cloth
             self.environment_ms, self.occlusion = stored.environment_ms, stored.occlusion
+            self.horizon = stored.horizon
         else:
             if self.sheen == "none" and convert.principled_uses_sheen(material):
                 self.sheen = PRINCIPLED_SHEEN

@@ -17,7 +17,7 @@ from . import convert, convert_ui
 
 _ENUMS = {"specular": convert_ui.SPECULAR_ITEMS, "diffuse": convert_ui.DIFFUSE_ITEMS,
           "environment_ms": convert_ui.ENVIRONMENT_MS_ITEMS, "sheen": convert_ui.SHEEN_ITEMS,
-          "occlusion": convert_ui.OCCLUSION_ITEMS}
+          "occlusion": convert_ui.OCCLUSION_ITEMS, "horizon": convert_ui.HORIZON_ITEMS}
 
 
 def _features(material):
@@ -62,6 +62,7 @@ class RTL_PG_switches(bpy.types.PropertyGroup):
     cloth: BoolProperty(name="Cloth", get=_getter("cloth"), set=_setter("cloth"))
     environment_ms: _enum("environment_ms", "World Multiscattering")
     occlusion: _enum("occlusion", "World Occlusion")
+    horizon: _enum("horizon", "Area Light Horizon")
 
 
 classes = (RTL_PG_switches,)

@@ -249,27 +249,43 @@ def _corner_sockets(keys):
 # The equal-area polygon's corners are made where they are used (each edge's group builds its own from the
 # disk), so only the disk stays live, not the 12 corners (Cycles' SVM stack, Blender 4.5: a shade group with GGX,
 # CoD and this integral overflowed it with the corners held at once).
+_DISK_EXIT_PART = NodeFunction(
+    "RTL Disk Polygon Exit", lambda **kw: {"Exit Part": polygon.exit_part(_disk_corner(kw, "A"), _disk_corner(kw, "B"))},
+    dict(_DISK_SOCKETS, **_corner_sockets("AB")),
+    {"Exit Part": vector("The edge's crossing where it leaves the upper half-space, else 0", "XYZ")},
+    "One edge of the disk's equal-area polygon: its share of the exit point")
 _DISK_EDGE = NodeFunction(
     "RTL Disk Polygon Edge",
-    lambda **kw: polygon.clipped_edge_terms(_disk_corner(kw, "A"), _disk_corner(kw, "B"), kw["Center"]),
-    dict(_DISK_SOCKETS, **_corner_sockets("AB")), polygon.CLIPPED_EDGE_SOCKETS,
-    "One edge of the disk's equal-area polygon clipped at the horizon, in Arvo's form factor about the disk's "
-    "centre")
+    lambda **kw: polygon.connected_edge_terms(_disk_corner(kw, "A"), _disk_corner(kw, "B"), _disk_corner(kw, "C"),
+                                              kw["Exit"], kw["O"]),
+    dict(_DISK_SOCKETS, **_corner_sockets("ABC"), Exit=vector("The polygon's exit point", "XYZ"),
+         O=vector("A point of the clipped polygon", "XYZ")),
+    {"Area": Socket("float", 0.0, description="z of sum w (a - o) x (b - o) over the edge's two arcs"),
+     "Flow": vector("sum w (b - a) over the edge's two arcs", "XYZ")},
+    "One edge of the disk's equal-area polygon clipped at the horizon and its connection to the next, in Arvo's "
+    "form factor")
+
+
+def _sum(terms):
+    return functools.reduce(operator.add, terms)
 
 
 def polygon_form_factor_z(c, v1, v2, sides=CLIPPED_DISK_SIDES):
     """z of the vector form factor of the transformed disk's equal-area ``sides``-gon clipped at the horizon
-    (``polygon.clipped_form_factor_z`` about the centre, corners built per edge); traceable."""
+    (``polygon.connected_edge_terms``, corners built per edge: polygon.py says why not the running sums);
+    traceable."""
     radius = float(np.sqrt(2.0 * np.pi / (sides * np.sin(2.0 * np.pi / sides))))
     angles = [(float(radius * np.cos(f)), float(radius * np.sin(f))) for f in 2.0 * np.pi * np.arange(sides) / sides]
     disk = {"Center": c, "Axis U": v1, "Axis V": v2}
 
     def corners(*indices):
-        return {f"{t} {k}": angles[i % sides][j] for k, i in zip("AB", indices) for j, t in enumerate(("Cos", "Sin"))}
+        return {f"{t} {k}": angles[i % sides][j] for k, i in zip("ABC", indices) for j, t in enumerate(("Cos", "Sin"))}
 
-    terms = [_DISK_EDGE(**disk, **corners(i, i + 1)) for i in range(sides)]
-    sums = (functools.reduce(operator.add, [t[name] for t in terms]) for name in polygon.CLIPPED_EDGE_SOCKETS)
-    return polygon.clipped_sum_z(*sums, c)
+    exit_point = _sum([_DISK_EXIT_PART(**disk, **corners(i, i + 1))["Exit Part"] for i in range(sides)])
+    origin = polygon.clipped_origin(c + op.scale(v1, angles[0][0]) + op.scale(v2, angles[0][1]),
+                                    c + op.scale(v1, angles[1][0]) + op.scale(v2, angles[1][1]), exit_point)
+    terms = [_DISK_EDGE(**disk, **corners(i, i + 1, i + 2), Exit=exit_point, O=origin) for i in range(sides)]
+    return polygon.connected_sum_z(_sum([t["Area"] for t in terms]), _sum([t["Flow"] for t in terms]), origin)
 
 
 def disk_integral_horizon_clipped(c, v1, v2, two_sided, sphere_table=None, sides=CLIPPED_DISK_SIDES, closed=None):

@@ -39,10 +39,13 @@ class QuadLight:
     or an array (..., 4, 3).  One-sided lights emit on the side away from which (c1 - c0) x (c3 - c0)
     points (corners clockwise seen from the lit side; ltc_code's convention, ``polygon.behind``).
     ``two_sided``: bool, or a 0/1 float / Expr.  ``center_point``: the centre, when known more precisely
-    than the corners' mean (the light's location: the side test uses it, ``polygon.behind``)."""
+    than the corners' mean (the light's location: the side test uses it, ``polygon.behind``).
+    ``exact_horizon``: the lobes' integrals clip the transformed light at the horizon instead of reading the
+    sphere table (``integral``; issue 30, docs/area_lights.md "RT Lit's exact horizon")."""
     corners: object
     two_sided: object = False
     center_point: object = None
+    exact_horizon: bool = False
 
     def corner_list(self):
         corners = polygon.corner_vectors(self.corners)
@@ -55,10 +58,11 @@ class QuadLight:
             return self.center_point
         return op.scale(functools.reduce(operator.add, self.corner_list()), 0.25)
 
-    def integral(self, tables, c, frame, p, exact_horizon=False):
+    def integral(self, tables, c, frame, p, exact_horizon=None):
         """LTC integral for packed Minv entries c in the shading frame ``frame`` (``polygon.local_frame``);
-        ``exact_horizon``: clip the transformed quad at the horizon (``polygon.LTC_QUAD_INTEGRAL_CLIPPED``)
-        instead of the sphere table."""
+        ``exact_horizon`` (None: the light's own): clip the transformed quad at the horizon
+        (``polygon.LTC_QUAD_INTEGRAL_CLIPPED``) instead of the sphere table."""
+        exact_horizon = self.exact_horizon if exact_horizon is None else exact_horizon
         local = [polygon.frame_coordinates(frame, q - p) for q in self.corner_list()]
         args = {f"c{i}": c[i] for i in range(4)}
         args.update({f"p{i}": local[i] for i in range(4)})
@@ -76,9 +80,11 @@ class DiskLight:
     axis_u: object
     axis_v: object
     two_sided: object = False
+    exact_horizon: bool = False
 
-    def integral(self, tables, c, frame, p, exact_horizon=False):
+    def integral(self, tables, c, frame, p, exact_horizon=None):
         """As ``QuadLight.integral``; ``exact_horizon``: ``disk.LTC_DISK_INTEGRAL_CLIPPED``."""
+        exact_horizon = self.exact_horizon if exact_horizon is None else exact_horizon
         args = {f"c{i}": c[i] for i in range(4)}
         args.update({"Center": polygon.frame_coordinates(frame, self.center - p),
                      "Axis U": polygon.frame_coordinates(frame, self.axis_u),
@@ -88,19 +94,17 @@ class DiskLight:
         return fn(tables, **args)["Integral"]
 
 
-def lobe_integral(tables, prefix, light, p, n, v, roughness, exact_horizon=False):
+def lobe_integral(tables, prefix, light, p, n, v, roughness):
     """(LTC integral, magnitude, fresnel) of one table's lobe at this shading point (with its band, for a lobe
-    that has one: ``band_integral``); ``exact_horizon``: the light clipped at the transformed horizon instead of
-    the sphere table's (``QuadLight.integral``)."""
+    that has one: ``band_integral``); the light's ``exact_horizon`` says how it meets the horizon."""
     mu = op.saturate(op.dot(n, v))
     frame = polygon.local_frame(n, v)
     band = catalog.LTC_BANDS.get(prefix)
     if band is None:
         packed, magnitude, fresnel = tables.ltc(prefix, mu, roughness)
-        return light.integral(tables, packed, frame, p, exact_horizon), magnitude, fresnel
+        return light.integral(tables, packed, frame, p), magnitude, fresnel
     packed, magnitude, fresnel, weight = tables.ltc(prefix, mu, roughness, band_weight=True)
-    return (band_integral(tables, light, packed, weight, band["squash"], frame, p, exact_horizon), magnitude,
-            fresnel)
+    return band_integral(tables, light, packed, weight, band["squash"], frame, p), magnitude, fresnel
 
 
 # The band (this project's, issue 15; docs/area_lights.md, "The band"): the lobe is the mixture
@@ -112,11 +116,11 @@ def mix_band(main, band, weight):
     return main + op.saturate(weight) * (band - main)
 
 
-def band_integral(tables, light, packed, weight, squash, frame, p, exact_horizon=False):
+def band_integral(tables, light, packed, weight, squash, frame, p):
     """Integral of the LTC with packed entries ``packed`` mixed with its band (squash factor ``squash``) by
-    ``weight``, over the light, in the shading frame ``frame``; ``exact_horizon`` as ``lobe_integral``."""
-    return mix_band(light.integral(tables, packed, frame, p, exact_horizon),
-                    light.integral(tables, matrix.squash_packed(packed, squash), frame, p, exact_horizon), weight)
+    ``weight``, over the light, in the shading frame ``frame``."""
+    return mix_band(light.integral(tables, packed, frame, p),
+                    light.integral(tables, matrix.squash_packed(packed, squash), frame, p), weight)
 
 
 # Heitz et al. 2016 with Hill 2016's Fresnel split: int f cos F = F0 (mag - fres) + F90 fres.
@@ -188,13 +192,13 @@ def disney_sheen_fitted(tables, light, p, n, v, sheen_color):
     return magnitude * value * sheen_color
 
 
-# Lambert is the identity LTC (Heitz et al. 2016, section 5), so the polygon clipped at the horizon gives its exact
-# form factor.  The clipless form's sphere table is exact only above the horizon: under a quad crossing it the cap it
-# stands for is far from the clipped polygon (issue 30's minimal case: 0.00180 for 0.00034, +424%).
+# Lambert is the identity LTC (Heitz et al. 2016, section 5): the light's exact form factor above the horizon.
+# Where the light crosses it the clipless form's sphere table stands for a cap far from the clipped polygon (issue
+# 30's minimal case: 0.00180 for 0.00034, +424%); a light with ``exact_horizon`` clips it (the quad exactly, the
+# disk by its closed form above the horizon and an equal-area 12-gon where it crosses).
 def lambert(tables, light, p, n, v, albedo):
-    """Lambert's form factor of the light clipped exactly at the horizon (``exact_horizon``: the quad clipped,
-    the disk's closed form above the horizon and its clipped form where it crosses) times ``albedo``."""
-    return light.integral(tables, IDENTITY, polygon.local_frame(n, v), p, exact_horizon=True) * albedo
+    """Lambert's form factor of the light (clipped at the horizon where the light says so) times ``albedo``."""
+    return light.integral(tables, IDENTITY, polygon.local_frame(n, v), p) * albedo
 
 
 def light_center(light):
@@ -267,7 +271,8 @@ def wrapped_light(light, p, n, wrap):
     (conjugate semi-axes of the image, to first order; w = 0 gives the light itself)."""
     if isinstance(light, QuadLight):
         corners = [p + _wrapped(q - p, n, wrap) for q in light.corner_list()]
-        return QuadLight(corners, two_sided=True, center_point=p + _wrapped(light.center() - p, n, wrap))
+        return QuadLight(corners, two_sided=True, center_point=p + _wrapped(light.center() - p, n, wrap),
+                         exact_horizon=light.exact_horizon)
     c = light.center - p
     normal = op.cross(light.axis_u, light.axis_v)
     depth = op.dot(normal, c)
@@ -284,7 +289,8 @@ def wrapped_light(light, p, n, wrap):
     v1, v2 = on_plane(c + light.axis_v), on_plane(c - light.axis_v)
     # the centre mapped itself, not the mean of the four points: for a light much larger than its distance the
     # points are ~|axis| away and their mean loses the centre to float32 rounding
-    return DiskLight(p + on_plane(c), op.scale(u1 - u2, 0.5), op.scale(v1 - v2, 0.5), two_sided=True)
+    return DiskLight(p + on_plane(c), op.scale(u1 - u2, 0.5), op.scale(v1 - v2, 0.5), two_sided=True,
+                     exact_horizon=light.exact_horizon)
 
 
 def cod_wrapped_diffuse(tables, light, p, n, v, roughness, albedo, wrap):

@@ -171,12 +171,18 @@ def _arguments(fn, available):
     return {name: available[name] for name in fn.input_sockets}
 
 
+def exact_horizon(features, kind):
+    """Whether the lobes clip a light of ``kind`` at the horizon (``Features.horizon``): every area light under
+    "exact", quads only under "exact_quads", none under "sphere_table"."""
+    return features.horizon == "exact" or (features.horizon == "exact_quads" and lights.shading_form(kind) == "quad")
+
+
 @functools.lru_cache(maxsize=None)
 def shade_function(kind, features):
     """``RTL Shade <Kind> (<features>)``: one light's radiance towards the viewer (``kind`` a base kind: its
     options change the light's data, not its shading)."""
     color_name = light_color_name(kind)
-    functions = [lobes.LOBES[key].function(kind) for key in lobe_keys(features)]
+    functions = [lobes.LOBES[key].function(kind, exact_horizon(features, kind)) for key in lobe_keys(features)]
     area = lights.shading_form(kind) != "punctual"
 
     def shade(tables, **kw):

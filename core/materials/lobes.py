@@ -65,10 +65,12 @@ class Lobe:
     area_text: str
     reads_tables_punctual: bool = field(default=False)
 
-    def function(self, kind):
+    def function(self, kind, exact_horizon=False):
         """The node function of this lobe for a light kind (cached; one for all punctual kinds; a kind's options
-        change the light's data, not its lobes)."""
-        return _lobe_function(self.key, lights.shading_form(kind))
+        change the light's data, not its lobes); ``exact_horizon``: area lights clipped at the horizon, else the
+        sphere table (``Features.horizon``)."""
+        form = lights.shading_form(kind)
+        return _lobe_function(self.key, form, bool(exact_horizon) or form == "punctual")
 
 
 def punctual_cosines(n, v, l):
@@ -141,8 +143,8 @@ KULLA_CONTY = Lobe("kulla_conty", "Kulla-Conty", ("Roughness",), _KC_OUT, _kulla
 
 
 # --- Lambert ----------------------------------------------------------------------------------------
-# max(N.L, 0) / pi; over an area light the identity LTC's form factor (Heitz et al. 2016, sec. 5) of the light
-# clipped at the horizon (``shading.lambert``: quads exact, disks by a 12-gon where they cross it).
+# max(N.L, 0) / pi; over an area light the identity LTC's form factor (Heitz et al. 2016, sec. 5), exact above the
+# horizon and, with an exact horizon (``Features.horizon``), where the light crosses it (``shading.lambert``).
 
 def _lambert_punctual(tables, N, V, L):
     mu_l = op.dot(N, L)
@@ -154,7 +156,7 @@ def _lambert_area(tables, light, Position, N, V):
 
 
 LAMBERT = Lobe("lambert", "Lambert", (), {"Diffuse": _OUT}, _lambert_punctual, _lambert_area,
-               "Lambert: max(N.L, 0) / pi", "Lambert form factor / albedo 1 (identity LTC, clipped at the horizon)")
+               "Lambert: max(N.L, 0) / pi", "Lambert form factor / albedo 1 (identity LTC)")
 
 
 # --- CoD WWII multiscattering diffuse (Chan 2018; the talk) ------------------------------------------
@@ -328,10 +330,11 @@ LOBES.update({lobe.key: lobe for lobe in (ZELTNER, DISNEY_FITTED)})
 
 # --- node functions -----------------------------------------------------------------------------------
 
-def _area_light(kind, kw):
+def _area_light(kind, kw, exact_horizon):
     if kind == "quad":
-        return shading.QuadLight([kw["p0"], kw["p1"], kw["p2"], kw["p3"]], center_point=kw["Center"])
-    return shading.DiskLight(kw["Center"], kw["Axis U"], kw["Axis V"])
+        return shading.QuadLight([kw["p0"], kw["p1"], kw["p2"], kw["p3"]], center_point=kw["Center"],
+                                 exact_horizon=exact_horizon)
+    return shading.DiskLight(kw["Center"], kw["Axis U"], kw["Axis V"], exact_horizon=exact_horizon)
 
 
 def light_geometry_sockets(kind):
@@ -341,7 +344,7 @@ def light_geometry_sockets(kind):
 
 
 @functools.lru_cache(maxsize=None)
-def _lobe_function(key, kind):
+def _lobe_function(key, kind, exact_horizon):
     lobe = LOBES[key]
     params = {p: _PARAMETERS[p] for p in lobe.parameters}
     if kind == "punctual":
@@ -354,10 +357,12 @@ def _lobe_function(key, kind):
 
     def body(tables, **kw):
         args = {p: kw[p] for p in lobe.parameters}
-        return lobe.area(tables, _area_light(kind, kw), kw["Position"], kw["N"], kw["V"], **args)
+        return lobe.area(tables, _area_light(kind, kw, exact_horizon), kw["Position"], kw["N"], kw["V"], **args)
 
     inputs = dict({"Position": _P, "N": _N, "V": _V}, **geometry, **params)
-    return NodeFunction(f"RTL {kind.capitalize()} {lobe.title}", body, inputs, lobe.outputs, lobe.area_text,
+    suffix = "" if exact_horizon else " (Sphere Table Horizon)"
+    return NodeFunction(f"RTL {kind.capitalize()} {lobe.title}{suffix}", body, inputs, lobe.outputs,
+                        lobe.area_text + ("" if exact_horizon else "; the sphere table's horizon (the talk's)"),
                         tables=REFERENCES)
 
 

@@ -40,6 +40,15 @@ ENVIRONMENT_MS_FORMS = ("irradiance", "radiance")
 #: Jimenez et al. 2016's cones ("cones") or the cones clipped by the horizon ("cones_clipped", the most
 #: accurate of the three in docs/benchmarks/specular_occlusion.md).  The lights are not occluded by it.
 OCCLUSION_MODELS = ("none", "lagarde", "cones", "cones_clipped")
+#: How the lobes' LTC integrals meet the receiver's horizon under area lights (issue 30; docs/area_lights.md,
+#: "RT Lit's exact horizon"): "sphere_table" is the talk's clipless form for every light (Hill & Heitz 2017),
+#: "exact_quads" clips quad lights exactly at the horizon and leaves disks (and sphere lights) to the sphere table,
+#: "exact" clips disks too (an equal-area 12-gon where they cross it).  Measured (docs/benchmarks/horizon.md):
+#: clipping takes GGX under quads crossing the horizon from 17% to 3.5% p90 and Lambert to float precision, for
+#: ~1.8x a quad light's nodes; disks gain less for ~5x theirs.  The default stays the talk's form: in Blender
+#: 4.5 the clipped integrals overflow Cycles' SVM stack (black renders) for most feature sets (all fit in 5.2).
+#: The Zeltner sheen clips under all three.
+HORIZON_MODELS = ("sphere_table", "exact_quads", "exact")
 #: The model an artist gets when switching world occlusion on (the Convert dialog, New Lookdev Scene).
 DEFAULT_OCCLUSION = "cones_clipped"
 
@@ -157,6 +166,7 @@ class Features:
     cloth: bool = False
     environment_ms: str = "irradiance"   # one of ENVIRONMENT_MS_FORMS (Fdez-Aguera under the world)
     occlusion: str = "none"              # one of OCCLUSION_MODELS (the World term's occlusion)
+    horizon: str = "sphere_table"        # one of HORIZON_MODELS (the lobes under area lights)
 
     def __post_init__(self):
         if isinstance(self.sheen, (bool, int)):       # the old switch (stored materials, Features(sheen=True))
@@ -171,6 +181,8 @@ class Features:
             raise ValueError(f"environment_ms must be one of {ENVIRONMENT_MS_FORMS}, got {self.environment_ms!r}")
         if self.occlusion not in OCCLUSION_MODELS:
             raise ValueError(f"occlusion must be one of {OCCLUSION_MODELS}, got {self.occlusion!r}")
+        if self.horizon not in HORIZON_MODELS:
+            raise ValueError(f"horizon must be one of {HORIZON_MODELS}, got {self.horizon!r}")
 
     def as_dict(self):
         return asdict(self)
@@ -187,6 +199,8 @@ class Features:
         parts += [p for p, on in ((_SHEEN_LABELS[self.sheen], self.sheen != "none"), ("cloth", self.cloth)) if on]
         if self.occlusion != "none":
             parts.append(f"{self.occlusion.replace('_', '-')} AO")
+        if self.horizon != "sphere_table":
+            parts.append(f"{self.horizon.replace('_', '-')} horizon")
         return ", ".join(parts)
 
 

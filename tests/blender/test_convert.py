@@ -496,10 +496,29 @@ def test_switches_in_the_panel_rebuild_the_group(bpy_module, empty_scene, lut_di
         assert "kulla-conty, cod, zeltner sheen" in rt.node_tree.name
         assert rt.inputs["Roughness"].default_value == roughness and rt.inputs["Base Color"].is_linked
         assert (switches.specular, switches.sheen) == ("kulla_conty", "zeltner")
+        assert switches.horizon == "sphere_table"
+        switches.horizon = "exact_quads"                   # quads clipped at the horizon: its own group, values kept
+        assert convert.stored_features(mat) == Features("kulla_conty", "cod", sheen="zeltner", horizon="exact_quads")
+        rt = convert.find_rt_lit_node(mat)
+        assert "exact-quads horizon" in rt.node_tree.name and rt.inputs["Base Color"].is_linked
         mat["rtl_features"]["sheen"] = 1           # a file saved with the old switch: the talk's Disney sheen
         assert switches.sheen == "disney_talk"
     finally:
         addon.unregister()
+
+
+def test_exact_horizon_warns_in_blender_4(bpy_module, convert, factory):
+    """An exact area-light horizon converts everywhere, with a warning in Blender 4.x, whose Cycles runs out of
+    shader stack for most feature sets with it (docs/area_lights.md)."""
+    from rt_lookdev.addon import compat
+
+    mat = compat.new_material("Horizon")
+    result = convert.principled_to_rt_lit(mat, factory, Features("turquin", "cod", horizon="exact_quads"))
+    assert result.status == "converted" and convert.stored_features(mat).horizon == "exact_quads"
+    warned = any("shader stack" in w for w in result.warnings)
+    assert warned == (bpy_module.app.version < (5, 0, 0))
+    plain = convert.principled_to_rt_lit(mat, factory, Features("turquin", "cod"))
+    assert not any("shader stack" in w for w in plain.warnings)
 
 
 def test_diffuse_roughness_maps_both_ways_and_is_proposed(bpy_module, convert, factory):

@@ -76,6 +76,23 @@ def test_area_lobe_groups_match_numpy(empty_scene, tables, kind, lobe):
     assert max(counts.values()) <= MAX_GROUP_NODES
 
 
+# Exact horizons (Features.horizon, issue 30) render as numpy where they fit Cycles' SVM stack in Blender 4.5 too (in
+# 5.2 every lobe and feature set fits); GGX under a clipped disk does not fit 4.5's.
+@pytest.mark.parametrize("kind, lobe", [("quad", "lambert"), ("quad", "ggx"), ("quad", "cod"), ("disk", "lambert"),
+                                        ("disk", "cod")])
+def test_exact_horizon_groups_match_numpy(empty_scene, tables, kind, lobe):
+    from rt_lookdev.core.materials import light_shading
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    fn = LOBES[lobe].function(kind, exact_horizon=True)
+    vals = _area_inputs(kind)
+    check_function(fn, {k: vals[k] for k in fn.input_sockets}, tables)
+    if kind == "quad" and lobe == "ggx":
+        shade = light_shading.shade_function(kind, Features("turquin", "cod", horizon="exact_quads"))
+        vals = shade_inputs(kind)
+        check_function(shade, {k: np.asarray(vals[k], np.float32) for k in shade.input_sockets}, tables)
+
+
 @pytest.mark.parametrize("kind", ["quad", "disk", "point", "spot", "sun"])
 def test_shade_groups_match_numpy(empty_scene, tables, kind):
     """A whole light on the material (all lobes of two feature sets), nested groups included."""

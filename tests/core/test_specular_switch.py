@@ -41,9 +41,11 @@ def test_no_specular_carries_no_specular_nodes_or_tables():
     off = rt_lit.build_rt_lit(Features("none", "lambert"), ("quad", "point"))
     on = rt_lit.build_rt_lit(Features("single", "lambert"), ("quad", "point"))
     assert "ggx" not in light_shading.lobe_keys(Features("none", "lambert"))
-    # no table at all: Lambert's area integral clips the light at the horizon (core/ltc/shading.py ``lambert``), so
-    # even the sphere table (channel A of ltc_ggx_mag) goes
-    assert table_names(off.function.outputs) == []
+    # only the sphere table stays (channel A of ltc_ggx_mag: the LTC integrals' horizon, core/ltc/shading.py) ...
+    assert table_names(off.function.outputs) == ["ltc_ggx_mag"]
+    # ... and goes with an exact horizon: Lambert's integral then clips the quad
+    exact = rt_lit.build_rt_lit(Features("none", "lambert", horizon="exact_quads"), ("quad", "point"))
+    assert table_names(exact.function.outputs) == []
     assert {"ltc_ggx_inv", "ggx_one_minus_E"} <= set(table_names(on.function.outputs))
     assert flat_node_count(tuple(off.function.outputs.values())) < 0.5 * flat_node_count(
         tuple(on.function.outputs.values()))

@@ -10,12 +10,13 @@ Lights: centre 0.3-3 m from the shading point (N = +Z, at the origin), quads 0.2
 drawn within 25 degrees of the horizon); the *above* set the lights wholly above it (centres anywhere from
 -20 degrees up), so both come from one generator and differ only in where the light lies.
 
-Lambert: ``core.ltc.shading.lambert`` (the exact horizon: quads clipped, disks by their closed form above the
-horizon and an equal-area 12-gon clipped where they cross it; numpy float64 and float32) and the clipless form it
-replaced (the identity LTC with the sphere table's horizon), against the clipped form factor by quadrature
+Lambert: ``core.ltc.shading.lambert`` with the exact horizon (quads clipped, disks by their closed form above the
+horizon and an equal-area 12-gon clipped where they cross it; numpy float64 and float32) and with the talk's
+clipless form (the identity LTC with the sphere table's horizon), against the clipped form factor by quadrature
 (``core.ltc.reference``), relative error over every light whose form factor is above 1e-6.
 Every LTC lobe (``catalog.LTC_LOBES``, with its band where it has one): ``shading.lobe_integral`` x the table's
-magnitude, as shipped (the sphere table's horizon) and with the exact horizon (the transformed light clipped),
+magnitude, with the sphere table's horizon (the talk's; ``Features.horizon`` "sphere_table", the default) and with
+the exact horizon (the transformed light clipped; "exact"),
 against the quadrature of the lobe's f cos, relative error over the lights that carry more than 10% of the lobe's
 albedo (as docs/benchmarks/ltc.md), crossing and above apart.
 Writes ``horizon.md`` and ``horizon.json`` in ``--out``.
@@ -28,14 +29,18 @@ import numpy as np
 
 from ..harness import entry, outputs
 from .ltc_random_lights import error_stats, fmt_stats, true_integral
-from ...core.ltc import fit, fit_lobes, polygon, shading
+from ...core.ir.expr import table_filter
+from ...core.ir.numpy_backend import flat_node_count
+from ...core.ltc import fit, fit_lobes, shading
 from ...core.lut import catalog, lookup
 from ...core.lut.catalog import default_lut_dir
+from ...core.materials import rt_lit
+from ...core.materials.rt_lit_interface import HORIZON_MODELS, Features
 
 ORIGIN = np.zeros(3)
 NORMAL = np.array([0.0, 0.0, 1.0])
 FORM_FACTOR_FLOOR = 1e-6
-LAMBERT_MODELS = ("shipped (exact horizon)", "shipped, float32", "clipless (sphere table)")
+LAMBERT_MODELS = ("exact horizon", "exact horizon, float32", "sphere table (default)")
 
 
 # --- lights --------------------------------------------------------------------------------------
@@ -101,9 +106,11 @@ def horizon_lights(kind, count, crossing, seed):
     return out
 
 
-def shading_light(kind, geom, dtype=np.float64):
+def shading_light(kind, geom, dtype=np.float64, exact_horizon=False):
     geom = [np.asarray(g, dtype=dtype) for g in geom]
-    return shading.QuadLight(np.stack(geom)) if kind == "quad" else shading.DiskLight(*geom)
+    if kind == "quad":
+        return shading.QuadLight(np.stack(geom), exact_horizon=exact_horizon)
+    return shading.DiskLight(*geom, exact_horizon=exact_horizon)
 
 
 # --- Lambert -------------------------------------------------------------------------------------
@@ -113,14 +120,12 @@ def _lambert_f_cos(l, v):
 
 
 def lambert_models(tables, kind, geom, v):
-    """Lambert's form factor by the shipped shading (float64, float32) and by the clipless form."""
+    """Lambert's form factor with the exact horizon (float64, float32) and with the sphere table's."""
     out = {}
-    for model, dtype in zip(LAMBERT_MODELS[:2], (np.float64, np.float32)):
+    for model, dtype, exact in zip(LAMBERT_MODELS, (np.float64, np.float32, np.float64), (True, True, False)):
         cast = lambda a, dtype=dtype: np.asarray(a, dtype=dtype)      # noqa: E731
-        out[model] = float(shading.lambert(tables, shading_light(kind, geom, dtype), cast(ORIGIN), cast(NORMAL),
-                                           cast(v), dtype(1.0)))
-    frame = polygon.local_frame(NORMAL, v)
-    out[LAMBERT_MODELS[2]] = float(shading_light(kind, geom).integral(tables, shading.IDENTITY, frame, ORIGIN))
+        out[model] = float(shading.lambert(tables, shading_light(kind, geom, dtype, exact), cast(ORIGIN),
+                                           cast(NORMAL), cast(v), dtype(1.0)))
     return out
 
 
@@ -151,13 +156,13 @@ def lambert_study(tables, count, seed):
 
 # --- every LTC lobe ------------------------------------------------------------------------------
 
-LOBE_MODELS = {"sphere table (shipped)": False, "exact horizon": True}
+LOBE_MODELS = {"sphere table (default)": False, "exact horizon": True}
 
 
 def lobe_estimate(tables, prefix, kind, geom, v, r, exact_horizon):
     """The LTC estimate of the lobe's f cos integral (F = 1): integral x magnitude."""
-    integral, magnitude, _ = shading.lobe_integral(tables, prefix, shading_light(kind, geom), ORIGIN, NORMAL, v,
-                                                   np.float64(r), exact_horizon)
+    integral, magnitude, _ = shading.lobe_integral(tables, prefix, shading_light(kind, geom, exact_horizon=exact_horizon),
+                                                   ORIGIN, NORMAL, v, np.float64(r))
     return float(integral) * float(magnitude)
 
 
@@ -182,6 +187,31 @@ def lobe_study(tables, count, seed):
     return result
 
 
+# --- cost ----------------------------------------------------------------------------------------
+
+COST_FEATURES = {"single + Lambert": Features("single", "lambert"), "Turquin + CoD (default)": Features(),
+                 "Kulla-Conty + wrapped + Zeltner sheen + cloth": Features("kulla_conty", "wrapped", sheen="zeltner",
+                                                                           cloth=True)}
+
+
+def _flat(features, kinds):
+    return flat_node_count(tuple(rt_lit.build_rt_lit(features, kinds).function.outputs.values()))
+
+
+def light_costs():
+    """Operations of one quad and one disk light in the Cycles tree (Linear table reads), per horizon."""
+    out = {}
+    with table_filter("linear"):
+        for label, features in COST_FEATURES.items():
+            row = {}
+            for horizon in HORIZON_MODELS:
+                f = Features(**dict(features.as_dict(), horizon=horizon))
+                base = _flat(f, ())
+                row.update({f"{kind}, {horizon}": _flat(f, (kind,)) - base for kind in ("quad", "disk")})
+            out[label] = row
+    return out
+
+
 # --- the benchmark -------------------------------------------------------------------------------
 
 def parse_args(argv):
@@ -199,6 +229,7 @@ def run(args, progress=entry.flush_log):
     progress("horizon: every LTC lobe")
     result["lobe_lights_per_set"] = count // 2 if args.quick else count
     result["lobes"] = lobe_study(tables, result["lobe_lights_per_set"], args.seed + 1)
+    result["light_costs"] = light_costs()
     result["seconds"] = time.perf_counter() - t0
     outputs.write_results(args.out, "horizon", result, to_markdown(result))
     return result
@@ -220,7 +251,7 @@ def to_markdown(result):
                  f"{outputs.scientific(e[m]['rel_max'])}" for m in LAMBERT_MODELS]
         L.append(f"| {key} | {e['lights']} | {outputs.scientific(e['smallest_form_factor'])} | "
                  + " | ".join(cells) + f" | {outputs.scientific(e['reference_max_rel_error'])} |")
-    L += ["", "## Every LTC lobe: the sphere table's horizon (shipped) and the exact horizon", "",
+    L += ["", "## Every LTC lobe: the sphere table's horizon (the talk's, the default) and the exact horizon", "",
           "The band where the table has one. Relative error over the lights carrying > 10% of the lobe's albedo; "
           "absolute error over the albedo over all lights.", "",
           "| lobe / light / set | horizon | n (>10%) | rel median | rel p90 | rel max | abs/albedo median | "
@@ -228,4 +259,10 @@ def to_markdown(result):
     for key, models in result["lobes"].items():
         for model, stats in models.items():
             L.append(f"| {key} | {model} | {fmt_stats(stats)}")
+    columns = list(next(iter(result["light_costs"].values())))
+    L += ["", "## Cost of one light in the Cycles tree (operations, Linear table reads)", "",
+          "The Zeltner sheen clips at the horizon under every setting.", "",
+          "| features | " + " | ".join(columns) + " |", "|---|" + "---|" * len(columns)]
+    for label, row in result["light_costs"].items():
+        L.append(f"| {label} | " + " | ".join(str(row[c]) for c in columns) + " |")
     return "\n".join(L) + "\n"

@@ -28,6 +28,7 @@ import platform
 import statistics
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +37,7 @@ from ...core.export import scene as scene_io
 from ...core.lights import SHADING_POINT_INPUTS, light_data
 from ...core.lut import catalog, exr_io
 from ...core.materials import rt_lit
-from ...core.materials.rt_lit_interface import Features, LIGHT_KINDS
+from ...core.materials.rt_lit_interface import HORIZON_MODELS, LIGHT_KINDS, Features
 from ..harness import entry, glsl_runner, grids
 from ...core.ir.semantics import sample_bilinear
 from ...core.lut.lookup import LutSet
@@ -237,6 +238,8 @@ def parse_args(argv):
     p.add_argument("--frames", type=int, default=5, help="timed frames after the first (median reported)")
     p.add_argument("--lights", default="1,4,16")
     p.add_argument("--features", default="minimal,all")
+    p.add_argument("--horizon", default=Features().horizon, choices=HORIZON_MODELS,
+                   help="the feature sets' area-light horizon (Features.horizon)")
     p.add_argument("--lut-dir", type=Path, default=None)
     p.add_argument("--out", type=Path, default=REPO / "docs" / "benchmarks" / "realtime.md")
     p.add_argument("--device-label", default=None, help="mark the rows as measured on this device (a GPU)")
@@ -272,6 +275,7 @@ def run(args, progress=entry.flush_log):
     with tempfile.TemporaryDirectory(prefix="rtl-realtime-bench-") as tmp:
         for fname in args.features.split(","):
             features, world = FEATURE_SETS[fname]
+            features = replace(features, horizon=args.horizon)
             for count in (int(c) for c in args.lights.split(",")):
                 desc = write_scene(Path(tmp) / f"{fname}_{count}", features, world, count,
                                    (args.width, args.height), lut_dir)
