@@ -28,7 +28,7 @@ import time
 import numpy as np
 
 from ..harness import entry, outputs
-from .ltc_random_lights import error_stats, fmt_stats, true_integral
+from .ltc_random_lights import error_stats, fmt_stats, light_facing_point, true_integral
 from ...core.ir.expr import table_filter
 from ...core.ir.numpy_backend import flat_node_count
 from ...core.ltc import fit, fit_lobes, shading
@@ -44,12 +44,6 @@ LAMBERT_MODELS = ("exact horizon", "exact horizon, float32", "sphere table (defa
 
 
 # --- lights --------------------------------------------------------------------------------------
-
-def _orthonormal(n):
-    t = np.cross(n, [0.0, 0.0, 1.0] if abs(n[2]) < 0.9 else [1.0, 0.0, 0.0])
-    t /= np.linalg.norm(t)
-    return t, np.cross(n, t)
-
 
 def crosses_horizon(kind, geom):
     """True when the light has area on both sides of z = 0."""
@@ -71,25 +65,7 @@ def _light(kind, rng, low_elevation):
     el = np.radians(rng.uniform(-25.0, 25.0) if low_elevation else rng.uniform(-20.0, 90.0))
     az = rng.uniform(0.0, 2.0 * np.pi)
     d = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
-    centre = d * rng.uniform(0.3, 3.0)
-    tilt = rng.normal(size=3)
-    tilt -= d * (tilt @ d)
-    tilt /= np.linalg.norm(tilt)
-    ang = np.radians(rng.uniform(0.0, 60.0))
-    normal = -(np.cos(ang) * d + np.sin(ang) * tilt)            # emits towards the point
-    t1, t2 = _orthonormal(normal)
-    if kind == "quad":
-        w, h = rng.uniform(0.2, 3.0, 2) / 2
-        corners = np.array([centre - w * t1 - h * t2, centre + w * t1 - h * t2,
-                            centre + w * t1 + h * t2, centre - w * t1 + h * t2])
-        if np.cross(corners[1] - corners[0], corners[3] - corners[0]) @ normal > 0:   # ltc_code's winding
-            corners = corners[::-1]
-        return corners
-    rad = rng.uniform(0.1, 1.5)
-    u, v = t1 * rad, t2 * rad
-    if np.cross(u, v) @ normal > 0:
-        v = -v
-    return centre, u, v
+    return light_facing_point(kind, rng, d, (0.3, 3.0), 60.0, (0.2, 3.0), (0.1, 1.5))
 
 
 def horizon_lights(kind, count, crossing, seed):

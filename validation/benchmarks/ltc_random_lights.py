@@ -19,6 +19,32 @@ def _orthonormal(n):
     return t, np.cross(n, t)
 
 
+def light_facing_point(kind, rng, direction, distance, max_tilt_deg, quad_side, disk_radius):
+    """A seeded light in ``direction`` (unit) from the shading point at the origin, ``distance`` (lo, hi) away, its
+    lit side turned towards the point within ``max_tilt_deg``: a quad (4, 3) of sides in ``quad_side`` (ltc_code's
+    winding: (c1 - c0) x (c3 - c0) points away from the lit side) or a disk (centre, axis_u, axis_v) of radius in
+    ``disk_radius`` (axis_u x axis_v points away from the lit side)."""
+    centre = direction * rng.uniform(*distance)
+    tilt = rng.normal(size=3)
+    tilt -= direction * (tilt @ direction)
+    tilt /= np.linalg.norm(tilt)
+    ang = np.radians(rng.uniform(0.0, max_tilt_deg))
+    normal = -(np.cos(ang) * direction + np.sin(ang) * tilt)          # emits towards the point
+    t1, t2 = _orthonormal(normal)
+    if kind == "quad":
+        w, h = rng.uniform(*quad_side, 2) / 2
+        corners = np.array([centre - w * t1 - h * t2, centre + w * t1 - h * t2,
+                            centre + w * t1 + h * t2, centre - w * t1 + h * t2])
+        if np.cross(corners[1] - corners[0], corners[3] - corners[0]) @ normal > 0:
+            corners = corners[::-1]
+        return corners
+    rad = rng.uniform(*disk_radius)
+    u, w2 = t1 * rad, t2 * rad
+    if np.cross(u, w2) @ normal > 0:
+        w2 = -w2
+    return centre, u, w2
+
+
 def random_lights(kind, count, lobe_name, seed):
     """Seeded random configurations: (r, theta_v, light geometry in the local frame).
 
@@ -42,27 +68,7 @@ def random_lights(kind, count, lobe_name, seed):
         else:
             el, az = np.radians(rng.uniform(-15.0, 90.0)), rng.uniform(0.0, 2 * np.pi)
             d = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
-        centre = d * rng.uniform(1.0, 4.0)
-        tilt = rng.normal(size=3)
-        tilt -= d * (tilt @ d)
-        tilt /= np.linalg.norm(tilt)
-        ang = np.radians(rng.uniform(0.0, 45.0))
-        normal = -(np.cos(ang) * d + np.sin(ang) * tilt)          # emits towards the point
-        t1, t2 = _orthonormal(normal)
-        if kind == "quad":
-            w, h = rng.uniform(0.3, 3.0, 2) / 2
-            corners = np.array([centre - w * t1 - h * t2, centre + w * t1 - h * t2,
-                                centre + w * t1 + h * t2, centre - w * t1 + h * t2])
-            # ltc_code's winding: (c1 - c0) x (c3 - c0) points away from the lit side
-            if np.cross(corners[1] - corners[0], corners[3] - corners[0]) @ normal > 0:
-                corners = corners[::-1]
-            geom = corners
-        else:
-            rad = rng.uniform(0.15, 1.5)
-            u, w2 = t1 * rad, t2 * rad
-            if np.cross(u, w2) @ normal > 0:      # axis_u x axis_v points away from the lit side
-                w2 = -w2
-            geom = (centre, u, w2)
+        geom = light_facing_point(kind, rng, d, (1.0, 4.0), 45.0, (0.3, 3.0), (0.15, 1.5))
         out.append((r, theta, v, geom))
     return out
 
