@@ -369,14 +369,15 @@ def _cross_z(a, b):
     return op.component(a, 0) * op.component(b, 1) - op.component(a, 1) * op.component(b, 0)
 
 
-def _arc_terms(a, b, o):
-    """(z of w (a - o) x (b - o), w (b - a)) of the arc a -> b (unit vectors), w its fitted edge factor: one
-    edge of ``vector_form_factor``'s cancellation-free sum about the unit point o."""
-    w = edge_weight(a, b)
+def _arc_terms(a, b, o, exact=False):
+    """(z of w (a - o) x (b - o), w (b - a)) of the arc a -> b (unit vectors), w its fitted edge factor (``exact``:
+    the exact one, ``edge_weight_exact``): one edge of ``vector_form_factor``'s cancellation-free sum about the
+    unit point o."""
+    w = edge_weight_exact(a, b) if exact else edge_weight(a, b)
     return _cross_z(a - o, b - o) * w, op.scale(b - a, w)
 
 
-def clipped_edge_terms(a, b, origin, sums=None):
+def clipped_edge_terms(a, b, origin, sums=None, exact=False):
     """{"Area", "Flow"}: the terms of the part of the edge a -> b above the horizon (zero for an edge wholly
     below) in ``clipped_form_factor_z``'s sum about ``origin`` (a point near the polygon, not normalised);
     {"Exit", "Entry"}: the edge's crossing where it leaves (enters) the upper half-space, else 0.  ``sums``: the
@@ -385,7 +386,7 @@ def clipped_edge_terms(a, b, origin, sums=None):
     # an end below the horizon moves to the crossing; an edge wholly below becomes the arc x -> x, exactly zero
     start = op.normalize(op.vselect(above_a, a, x))
     end = op.normalize(op.vselect(above_b, b, x))
-    area, flow = _arc_terms(start, end, op.normalize(origin))
+    area, flow = _arc_terms(start, end, op.normalize(origin), exact)
     terms = {"Area": area, "Flow": flow, "Exit": op.scale(x, above_a * (1.0 - above_b)),
              "Entry": op.scale(x, above_b * (1.0 - above_a))}
     return terms if sums is None else {name: sums[name] + value for name, value in terms.items()}
@@ -434,11 +435,11 @@ def connected_sum_z(area, flow, origin):
     return area + _cross_z(op.normalize(origin), flow)
 
 
-def clipped_sum_z(sums, origin):
+def clipped_sum_z(sums, origin, exact=False):
     """z of the clipped polygon's vector form factor from its edges' running sums: the closing arc from the exit
     point to the entry point along the horizon added, then the origin's part o x flow."""
     o = op.normalize(origin)
-    closing_area, closing_flow = _arc_terms(op.normalize(sums["Exit"]), op.normalize(sums["Entry"]), o)
+    closing_area, closing_flow = _arc_terms(op.normalize(sums["Exit"]), op.normalize(sums["Entry"]), o, exact)
     return sums["Area"] + closing_area + _cross_z(o, sums["Flow"] + closing_flow)
 
 
@@ -461,18 +462,26 @@ def _running_sums(kw):
 # so only one set of sums (10 floats) is live between edges.  Summing the edges' outputs apart (four sums over K
 # groups) kept every edge's Flow, Exit and Entry live while the Area sum was compiled, and a 12-gon's overflowed
 # Cycles' SVM stack (255 floats) in Blender 4.5, which compiles nodes in the order they were made.
-_CLIPPED_FIRST_EDGE = NodeFunction(
-    "RTL Clipped First Edge", lambda **kw: clipped_edge_terms(kw["A"], kw["B"], kw["O"]), _EDGE_SOCKETS,
-    CLIPPED_EDGE_SOCKETS, "The first edge of a polygon clipped at the horizon (Sutherland-Hodgman) in Arvo's form "
-    "factor: the running sums' start")
-_CLIPPED_EDGE = NodeFunction(
-    "RTL Clipped Edge", lambda **kw: clipped_edge_terms(kw["A"], kw["B"], kw["O"], _running_sums(kw)),
-    dict(_EDGE_SOCKETS, **{f"{name} In": s for name, s in CLIPPED_EDGE_SOCKETS.items()}), CLIPPED_EDGE_SOCKETS,
-    "One edge of a polygon clipped at the horizon (Sutherland-Hodgman) in Arvo's form factor, added to the "
-    "running sums")
+def _clipped_edge_functions(exact):
+    suffix = " (Exact Edges)" if exact else ""
+    first = NodeFunction(
+        "RTL Clipped First Edge" + suffix, lambda **kw: clipped_edge_terms(kw["A"], kw["B"], kw["O"], exact=exact),
+        _EDGE_SOCKETS, CLIPPED_EDGE_SOCKETS, "The first edge of a polygon clipped at the horizon (Sutherland-Hodgman) "
+        "in Arvo's form factor: the running sums' start")
+    edge = NodeFunction(
+        "RTL Clipped Edge" + suffix,
+        lambda **kw: clipped_edge_terms(kw["A"], kw["B"], kw["O"], _running_sums(kw), exact=exact),
+        dict(_EDGE_SOCKETS, **{f"{name} In": s for name, s in CLIPPED_EDGE_SOCKETS.items()}), CLIPPED_EDGE_SOCKETS,
+        "One edge of a polygon clipped at the horizon (Sutherland-Hodgman) in Arvo's form factor, added to the "
+        "running sums")
+    return first, edge
 
 
-def clipped_form_factor_z(points):
+#: (first edge, further edge) groups: the fitted edge factor (the LTC lobes) and the exact one (Lambert).
+_CLIPPED_EDGES = {exact: _clipped_edge_functions(exact) for exact in (False, True)}
+
+
+def clipped_form_factor_z(points, exact=False):
     """z of the vector form factor (fitted edges) of the convex polygon ``points`` (K vectors, transformed,
     local frame, not normalised) clipped at z = 0: every edge's part above the horizon and the closing arc along
     it, summed as ``vector_form_factor`` does about the polygon's centroid, one nested group per edge; traceable.
@@ -480,20 +489,22 @@ def clipped_form_factor_z(points):
     pts = corner_vectors(points)
     k = len(pts)
     origin = op.scale(_sum(pts), 1.0 / k)
-    sums = _CLIPPED_FIRST_EDGE(A=pts[0], B=pts[1 % k], O=origin)
+    first_edge, next_edge = _CLIPPED_EDGES[exact]
+    sums = first_edge(A=pts[0], B=pts[1 % k], O=origin)
     for i in range(1, k):
-        sums = _CLIPPED_EDGE(A=pts[i], B=pts[(i + 1) % k], O=origin, **{f"{n} In": sums[n] for n in sums})
-    return clipped_sum_z(sums, origin)
+        sums = next_edge(A=pts[i], B=pts[(i + 1) % k], O=origin, **{f"{n} In": sums[n] for n in sums})
+    return clipped_sum_z(sums, origin, exact)
 
 
 @functools.lru_cache(maxsize=None)
-def clipped_form_factor_function(k):
-    """"RTL Clipped Form Factor (<k> corners)": ``clipped_form_factor_z`` of a convex k-gon."""
+def clipped_form_factor_function(k, exact=False):
+    """"RTL Clipped Form Factor (<k> corners)": ``clipped_form_factor_z`` of a convex k-gon (``exact``: with the
+    exact edge factor)."""
     def body(**kw):
-        return {"Fz": clipped_form_factor_z([kw[f"p{i}"] for i in range(k)])}
+        return {"Fz": clipped_form_factor_z([kw[f"p{i}"] for i in range(k)], exact)}
 
     return NodeFunction(
-        f"RTL Clipped Form Factor ({k} corners)", body,
+        f"RTL Clipped Form Factor ({k} corners{', exact edges' if exact else ''})", body,
         {f"p{i}": vector(f"Corner {i} (transformed, local frame)", "XYZ") for i in range(k)},
         {"Fz": Socket("float", 0.0, description="z of the vector form factor of the polygon's part above z = 0 "
                                                 "(signed: negative seen from its back)")},
@@ -507,13 +518,14 @@ def clipped_side_value(fz, back, lit, two_sided):
     return op.select(lit, op.select(back, value * two_sided, value), 0.0)
 
 
-def polygon_integral_horizon_clipped(transformed, two_sided, untransformed=None, center=None):
+def polygon_integral_horizon_clipped(transformed, two_sided, untransformed=None, center=None, exact_edges=False):
     """``polygon_integral_clipless`` with the exact horizon: the transformed quad clipped to z >= 0
     (``clipped_form_factor_z``), then the z of its vector form factor (Heitz et al. 2016, eq. 11); the same
-    side and edge-on tests.  Any convex polygon (K corners, 2K clipped points)."""
+    side and edge-on tests.  Any convex polygon (K corners, 2K clipped points).  ``exact_edges``: the exact edge
+    factor instead of the fit (Lambert's form factor, ``QUAD_FORM_FACTOR_CLIPPED``)."""
     pts = corner_vectors(transformed)
     plane = pts if untransformed is None else corner_vectors(untransformed)
-    fz = clipped_form_factor_function(len(pts))(**{f"p{i}": q for i, q in enumerate(pts)})["Fz"]
+    fz = clipped_form_factor_function(len(pts), exact_edges)(**{f"p{i}": q for i, q in enumerate(pts)})["Fz"]
     return clipped_side_value(fz, behind(plane, center), off_plane(plane, center), two_sided)
 
 
@@ -571,3 +583,22 @@ LTC_QUAD_INTEGRAL_CLIPPED = NodeFunction(
                                 "multiply by the lobe's magnitude")},
     description="LTC integral over a quad light with exact horizon clipping (Heitz et al. 2016)",
     tables=lookup.REFERENCES)
+
+
+# Lambert's form factor is the identity LTC's integral: no transform, and the exact edge factor, because the fit's
+# 1.4e-6 of an edge's term was the largest error of the clipped form factor (1.1e-4 of small lights; exact edges:
+# 1.5e-12 in float64, docs/benchmarks/horizon.md).  The LTC lobes keep the fit: their tables' error is larger by
+# orders, and the fit's float32 behaviour is what Cycles and the numpy backend agree on.
+def _quad_form_factor_clipped_node(**inputs):
+    corners = [inputs[f"p{i}"] for i in range(4)]
+    return {"Integral": polygon_integral_horizon_clipped(corners, inputs["Two Sided"], corners, inputs["Center"],
+                                                         exact_edges=True)}
+
+
+#: Lambert's form factor of a quad light clipped exactly at the horizon (exact edges).
+QUAD_FORM_FACTOR_CLIPPED = NodeFunction(
+    "RTL Quad Form Factor (Clipped)", _quad_form_factor_clipped_node,
+    inputs={k: s for k, s in LTC_QUAD_INTEGRAL.input_sockets.items() if not k.startswith("c")},
+    outputs={"Integral": Socket("float", 0.0, 0.0, 1.0, "FACTOR",
+                                "Lambert's form factor of the light, clipped exactly at the horizon")},
+    description="Form factor of a quad light with exact horizon clipping and exact edges (Heitz et al. 2016, eq. 11)")

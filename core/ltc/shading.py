@@ -71,6 +71,13 @@ class QuadLight:
         fn = polygon.LTC_QUAD_INTEGRAL_CLIPPED if exact_horizon else polygon.LTC_QUAD_INTEGRAL
         return fn(tables, **args)["Integral"]
 
+    def clipped_form_factor(self, frame, p):
+        """Lambert's form factor clipped exactly at the horizon (``polygon.QUAD_FORM_FACTOR_CLIPPED``)."""
+        args = {f"p{i}": polygon.frame_coordinates(frame, q - p) for i, q in enumerate(self.corner_list())}
+        args["Center"] = polygon.frame_coordinates(frame, self.center() - p)
+        args["Two Sided"] = self.two_sided
+        return polygon.QUAD_FORM_FACTOR_CLIPPED(**args)["Integral"]
+
 
 @dataclass(frozen=True)
 class DiskLight:
@@ -194,11 +201,14 @@ def disney_sheen_fitted(tables, light, p, n, v, sheen_color):
 
 # Lambert is the identity LTC (Heitz et al. 2016, section 5): the light's exact form factor above the horizon.
 # Where the light crosses it the clipless form's sphere table stands for a cap far from the clipped polygon (issue
-# 30's minimal case: 0.00180 for 0.00034, +424%); a light with ``exact_horizon`` clips it (the quad exactly, the
-# disk by its closed form above the horizon and an equal-area 12-gon where it crosses).
+# 30's minimal case: 0.00180 for 0.00034, +424%); a light with ``exact_horizon`` clips it (the quad exactly, with exact
+# edges; the disk by its closed form above the horizon and an equal-area 12-gon where it crosses).
 def lambert(tables, light, p, n, v, albedo):
     """Lambert's form factor of the light (clipped at the horizon where the light says so) times ``albedo``."""
-    return light.integral(tables, IDENTITY, polygon.local_frame(n, v), p) * albedo
+    frame = polygon.local_frame(n, v)
+    if isinstance(light, QuadLight) and light.exact_horizon:
+        return light.clipped_form_factor(frame, p) * albedo
+    return light.integral(tables, IDENTITY, frame, p) * albedo
 
 
 def light_center(light):
