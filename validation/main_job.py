@@ -12,7 +12,9 @@ Steps (each prints what it does):
    furnace with the LUT-driven lobe, the Fdez-Aguera and Turquin furnaces, and the talk's
    E_avg polynomial.
 3. LTC area lights (numpy): end-to-end error of the LTC tables on seeded random quads and
-   disks against brute-force integrals (a smaller set than scripts/benchmark_ltc.py).
+   disks against brute-force integrals (a smaller set than scripts/benchmark_ltc.py), and on lights
+   crossing the receiver's horizon and lights wholly above it, reported apart, with the sphere table's
+   horizon and the exact one (scripts/benchmark_horizon.py --quick's sets).
 4. LUT export for engines (scripts/export_luts.py): every format and precision in both layouts into
    <out>/export/rtl and <out>/export/ltc_code, read back against the source tables.
 5. Cycles render check: spheres under a white world (scripts/validate_energy.py).
@@ -56,6 +58,7 @@ from ..core import energy_checks as validation  # noqa: E402
 from ..core import lut_bake as bake
 from ..core.lut import catalog, lookup  # noqa: E402
 from ..core.export import luts as lut_export
+from .benchmarks import horizon_benchmark
 from .benchmarks import ltc_benchmark as benchmark_ltc
 from .benchmarks import ltc_random_lights
 from .benchmarks import realtime_benchmark
@@ -77,6 +80,8 @@ FURNACE_TOL = 1e-3              # Kulla-Conty E_ss + E_ms = 1, every r, mu >= 0.
 FDEZ_FURNACE_TOL = 5e-3         # Fdez-Aguera environment BRDF with F0 = 1
 LTC_MEDIAN_TOL = {"ggx": 0.015, "cod_diffuse": 0.01, "cloth": 0.01}   # quads, lights > 10% of the albedo
 LTC_LIGHTS = (120, 60)          # random quads and disks per BRDF in the main job
+HORIZON_LIGHTS = (24, 36)       # lights per set at the horizon: Lambert, every other lobe (of benchmark_horizon's 120)
+HORIZON_LAMBERT_TOL = 1e-4      # issue 30: Lambert's exact horizon under quads crossing it (float64; disks reported)
 
 
 def step_luts(lut_dir, log=entry.flush_log):
@@ -281,8 +286,43 @@ def step_ltc(lut_dir, log=entry.flush_log):
     results = ltc_random_lights.end_to_end(tables, None, *LTC_LIGHTS)
     out = {"lights_per_brdf": {"quads": LTC_LIGHTS[0], "disks": LTC_LIGHTS[1]}, "results": results,
            "seconds": round(time.perf_counter() - t0, 1)}
-    out["passed"] = all(results[f"{lobe}/quad"]["ours"]["rel_median"] <= tol for lobe, tol in LTC_MEDIAN_TOL.items())
+    log("      at the horizon: lights crossing it and lights wholly above it, apart")
+    luts = lookup.LutSet.from_folder(lut_dir)
+    seed = horizon_benchmark.parse_args([]).seed
+    lambert = horizon_benchmark.lambert_study(luts, HORIZON_LIGHTS[0], seed)
+    out["horizon"] = {"lights_per_set": {"lambert": HORIZON_LIGHTS[0], "lobes": HORIZON_LIGHTS[1]}, "lambert": lambert,
+                      "lobes": horizon_benchmark.lobe_study(luts, HORIZON_LIGHTS[1], seed + 1)}
+    out["seconds"] = round(time.perf_counter() - t0, 1)
+    out["passed"] = (all(results[f"{lobe}/quad"]["ours"]["rel_median"] <= tol for lobe, tol in LTC_MEDIAN_TOL.items())
+                     and lambert["quad/crossing"]["exact horizon"]["rel_max"] <= HORIZON_LAMBERT_TOL)
     return out
+
+
+def horizon_markdown(horizon):
+    """The main job report's section on lights at the horizon (step 3)."""
+    lines = ["### At the horizon", "",
+             f"{horizon['lights_per_set']['lambert']} lights per set for Lambert, {horizon['lights_per_set']['lobes']} "
+             "per set and lobe for the others, crossing the horizon or wholly above it (acceptance: Lambert's exact "
+             f"horizon under crossing quads, max relative error <= {HORIZON_LAMBERT_TOL:g}; disks, clipped as an "
+             "equal-area 12-gon, reported). Full benchmark: `python scripts/benchmark_horizon.py` "
+             "(docs/benchmarks/horizon.md).", "",
+             "| Lambert / light | n | exact horizon: median / max | float32: max | sphere table: median / max |",
+             "|---|---|---|---|---|"]
+    for key, e in horizon["lambert"].items():
+        ex, f32, table = (e[m] for m in ("exact horizon", "exact horizon, float32", "sphere table (default)"))
+        lines.append(f"| {key} | {e['lights']} | {ex['rel_median']:.1e} / {ex['rel_max']:.1e} | {f32['rel_max']:.1e} | "
+                     f"{table['rel_median']:.1e} / {table['rel_max']:.1e} |")
+    lines += ["", "| lobe / light / set | n (>10%) | sphere table: median / p90 | exact horizon: median / p90 |",
+              "|---|---|---|---|"]
+    def percent(stats):
+        if not stats["lights_over_10pct"]:
+            return "-"
+        return f"{100 * stats['rel_median']:.2f}% / {100 * stats['rel_p90']:.1f}%"
+
+    for key, models in horizon["lobes"].items():
+        table, ex = (models[m] for m in ("sphere table (default)", "exact horizon"))
+        lines.append(f"| {key} | {ex['lights_over_10pct']}/{ex['lights']} | {percent(table)} | {percent(ex)} |")
+    return lines + [""]
 
 
 def write_report(job, out_dir):
@@ -325,6 +365,8 @@ def write_report(job, out_dir):
         lines.append(f"| {key} | {o['lights_over_10pct']}/{o['lights']} | {100 * o['rel_median']:.2f}% | "
                      f"{100 * o['rel_p90']:.1f}% | {100 * o['abs_over_albedo_median']:.2f}% |")
     lines.append("")
+    if "horizon" in ltc:
+        lines += horizon_markdown(ltc["horizon"])
     export = job.get("lut_export")
     lines += ["## LUT export for engines", ""]
     lines += [export["summary_markdown"], ""] if export else ["Skipped.", ""]

@@ -6,6 +6,7 @@ from rt_lookdev.validation import main_job
 
 def test_report_is_written_from_the_steps(tmp_path, monkeypatch):
     monkeypatch.setattr(main_job, "LTC_LIGHTS", (6, 3))        # a small seeded light set: the same code path
+    monkeypatch.setattr(main_job, "HORIZON_LIGHTS", (6, 4))
     quiet = lambda *a: None                                     # noqa: E731
     job = {"date": "today", "seconds": 1.0,
            "luts": main_job.step_luts(catalog.default_lut_dir(), quiet),
@@ -17,6 +18,9 @@ def test_report_is_written_from_the_steps(tmp_path, monkeypatch):
     main_job.write_report(job, tmp_path / "skipped")
     text = (tmp_path / "skipped" / "report.md").read_text()
     assert text.count("Skipped (--skip-render).") == 6 and "## LTC area lights" in text
+    # the lights at the horizon, crossing and above apart, Lambert's exact horizon gated (issue 30)
+    assert "### At the horizon" in text and "| disk/crossing | 6 |" in text and "| ggx/quad/above |" in text
+    assert job["ltc"]["horizon"]["lambert"]["quad/crossing"]["exact horizon"]["rel_max"] < main_job.HORIZON_LAMBERT_TOL
     assert (tmp_path / "skipped" / "report.json").stat().st_size > 0
     job["render"] = {"settings": {"resolution_per_sphere": 8, "samples": 4, "seeds": [0, 1], "z_max": 5.0,
                                   "sys_tol": 5e-4, "ms_tol": 0.005}, "summary_markdown": "RENDER TABLE",
