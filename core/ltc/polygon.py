@@ -482,10 +482,10 @@ _CLIPPED_EDGES = {exact: _clipped_edge_functions(exact) for exact in (False, Tru
 
 
 def clipped_form_factor_z(points, exact=False):
-    """z of the vector form factor (fitted edges) of the convex polygon ``points`` (K vectors, transformed,
-    local frame, not normalised) clipped at z = 0: every edge's part above the horizon and the closing arc along
-    it, summed as ``vector_form_factor`` does about the polygon's centroid, one nested group per edge; traceable.
-    Negative seen from the polygon's back."""
+    """z of the vector form factor (fitted edges; ``exact``: the exact ones) of the convex polygon ``points`` (K
+    vectors, transformed, local frame, not normalised) clipped at z = 0: every edge's part above the horizon and the
+    closing arc along it, summed as ``vector_form_factor`` does about the polygon's centroid, one nested group per
+    edge (a running sum); traceable.  Negative seen from the polygon's back."""
     pts = corner_vectors(points)
     k = len(pts)
     origin = op.scale(_sum(pts), 1.0 / k)

@@ -1,5 +1,6 @@
 """The area lights' horizon switch (Features.horizon, issue 30): "sphere_table" (the default) keeps the talk's clipless
-form, "exact_quads" clips the lobes' LTC integrals at the horizon under quads, "exact" under disks too; measured against brute force on lights that cross it."""
+form, "exact_quads" clips the lobes' LTC integrals at the horizon under quads, "exact" under disks too; measured
+against brute force on lights that cross it."""
 from __future__ import annotations
 
 import numpy as np

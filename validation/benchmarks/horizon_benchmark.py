@@ -137,8 +137,8 @@ LOBE_MODELS = {"sphere table (default)": False, "exact horizon": True}
 
 def lobe_estimate(tables, prefix, kind, geom, v, r, exact_horizon):
     """The LTC estimate of the lobe's f cos integral (F = 1): integral x magnitude."""
-    integral, magnitude, _ = shading.lobe_integral(tables, prefix, shading_light(kind, geom, exact_horizon=exact_horizon),
-                                                   ORIGIN, NORMAL, v, np.float64(r))
+    light = shading_light(kind, geom, exact_horizon=exact_horizon)
+    integral, magnitude, _ = shading.lobe_integral(tables, prefix, light, ORIGIN, NORMAL, v, np.float64(r))
     return float(integral) * float(magnitude)
 
 
