@@ -729,7 +729,7 @@ LIGHT_DATA = {"quad": AREA_LIGHT_QUAD, "disk": AREA_LIGHT_DISK, "point": POINT_L
 SHADING_FORMS = {"quad": "quad", "disk": "disk", "sphere": "disk", "spot_sphere": "disk", "sun_disk": "disk",
                  "point": "punctual", "spot": "punctual", "sun": "punctual", "quad_spot": "punctual"}
 #: Inputs of a light's data function that the material feeds from the shading point, not from the light.
-SHADING_POINT_INPUTS = ("Position", "Normal")
+SHADING_POINT_INPUTS = ("Position",)
 
 
 def shading_form(kind):
@@ -787,7 +787,6 @@ _RANGE_SOCKET = {"Range": scalar(10.0, "Range r of the windowed falloff saturate
 
 _SPREAD_SOCKET = {"Spread": scalar(np.pi, "Spread angle of the area light (light data spread; core/light_spread.py)",
                                    0.0, np.pi, subtype="ANGLE", panel=_DATA_PANEL)}
-_NORMAL = {"Normal": vector("Shading normal (world space, unit)", "NONE", hide_value=True)}
 _EXCLUDED_SOCKET = {"Excluded": factor(0.0, "1 on an object that light linking excludes from this light (the "
                                             "object's attribute rtl_excluded_<light>), 0 where it receives it",
                                        panel=_DATA_PANEL)}
@@ -810,21 +809,36 @@ def control_factor(kind, position, params):
     return out
 
 
-def spread_geometry(base, light, position, normal, spread):
+#: What a light with spread hands its lobes besides its clamped region: its cone (``light_spread.SpreadCone``), by
+#: which each lobe weights its own integral (``light_spread.lobe_average``).
+SPREAD_OUTPUTS = {
+    "Spread Foot": vector("The shading point's foot on the light's plane (core/light_spread.py)", "XYZ"),
+    "Spread Radius": scalar(light_spread.FULL_RADIUS, "Radius R of the spread's cone on the light's plane"),
+    "Spread Scale": scalar(1.0, "The spread's normalisation c: the weight is c max(1 - rho / R, 0)"),
+}
+
+
+def spread_geometry(base, light, position, spread):
     """The outputs of a quad or disk light's data function (``light``) with Blender's spread applied
-    (core/light_spread.py): the clamped region's geometry and the radiance times the spread's factor."""
+    (core/light_spread.py): the clamped region's geometry, the cone (``SPREAD_OUTPUTS``) and the radiance, 0 where
+    the cone misses the light."""
     if base == "quad":
-        centre = light["Center"]
         half_u, half_v = op.scale(light["p1"] - light["p0"], 0.5), op.scale(light["p3"] - light["p0"], 0.5)
-        centre, eu, ev, weight = light_spread.spread_quad(position, normal, centre, half_u, half_v, spread)
+        centre, eu, ev, cone, hits = light_spread.spread_quad(position, light["Center"], half_u, half_v, spread)
         low, high = centre - eu, centre + eu
         out = {"p0": low - ev, "p1": high - ev, "p2": high + ev, "p3": low + ev, "Center": centre}
     else:
-        centre, axis_u, axis_v, weight = light_spread.spread_disk(position, normal, light["Center"], light["Axis U"],
-                                                                  light["Axis V"], spread)
+        centre, axis_u, axis_v, cone, hits = light_spread.spread_disk(position, light["Center"], light["Axis U"],
+                                                                      light["Axis V"], spread)
         out = {"Center": centre, "Axis U": axis_u, "Axis V": axis_v}
-    out["Radiance"] = op.scale(light["Radiance"], weight)
+    out["Radiance"] = op.scale(light["Radiance"], hits)
+    out.update({"Spread Foot": cone.foot, "Spread Radius": cone.radius, "Spread Scale": cone.scale})
     return out
+
+
+def spread_cone(light):
+    """The ``light_spread.SpreadCone`` in the outputs of a light with spread (``spread_geometry``)."""
+    return light_spread.SpreadCone(light["Spread Foot"], light["Spread Radius"], light["Spread Scale"])
 
 
 def _with_options(base, options):
@@ -835,7 +849,7 @@ def _with_options(base, options):
     def body(**kw):
         out = dict(data(**{k: kw[k] for k in data.input_sockets}))
         if "spread" in options:
-            out.update(spread_geometry(base, out, kw["Position"], kw["Normal"], kw["Spread"]))
+            out.update(spread_geometry(base, out, kw["Position"], kw["Spread"]))
         out[color_name] = op.scale(out[color_name], control_factor(kind, kw["Position"], kw))
         return out
 
@@ -850,11 +864,12 @@ def _with_options(base, options):
     if "linking" in options:
         inputs.update(_EXCLUDED_SOCKET)
     inputs.update(_POSITION)
+    outputs = dict(data.output_sockets)
     if "spread" in options:
-        inputs.update(_NORMAL)
+        outputs.update(SPREAD_OUTPUTS)
     words = {"cone": "the talk's cone falloff at the projector apex", "range": "the talk's windowed range",
              "spread": "Blender's spread", "linking": "Blender's light linking"}
-    return NodeFunction(f"{data.name} ({', '.join(options)})", body, inputs, dict(data.output_sockets),
+    return NodeFunction(f"{data.name} ({', '.join(options)})", body, inputs, outputs,
                         f"{data.description}; with " + " and ".join(words[o] for o in options))
 
 

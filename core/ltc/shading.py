@@ -19,7 +19,7 @@ import functools
 import operator
 from dataclasses import dataclass
 
-from .. import diffuse, multiscatter, sheen
+from .. import diffuse, light_spread, multiscatter, sheen
 from .. import shading_ops as op
 from ..ir.functions import NodeFunction
 from ..ir.interface import factor, vector
@@ -41,11 +41,14 @@ class QuadLight:
     ``two_sided``: bool, or a 0/1 float / Expr.  ``center_point``: the centre, when known more precisely
     than the corners' mean (the light's location: the side test uses it, ``polygon.behind``).
     ``exact_horizon``: the lobes' integrals clip the transformed light at the horizon instead of reading the
-    sphere table (``integral``; issue 30, docs/area_lights.md "RT Lit's exact horizon")."""
+    sphere table (``integral``; issue 30, docs/area_lights.md "RT Lit's exact horizon").
+    ``spread``: Blender's spread (a ``core.light_spread.SpreadCone``; the corners are then the region it clamps the
+    light to): every integral is weighted by the spread's weight averaged under its own lobe (``spread_weighted``)."""
     corners: object
     two_sided: object = False
     center_point: object = None
     exact_horizon: bool = False
+    spread: object = None
 
     def corner_list(self):
         corners = polygon.corner_vectors(self.corners)
@@ -69,25 +72,42 @@ class QuadLight:
         args["Center"] = polygon.frame_coordinates(frame, self.center() - p)
         args["Two Sided"] = self.two_sided
         fn = polygon.LTC_QUAD_INTEGRAL_CLIPPED if exact_horizon else polygon.LTC_QUAD_INTEGRAL
-        return fn(tables, **args)["Integral"]
+        return self.spread_weighted(fn(tables, **args)["Integral"], c, frame, p)
 
     def clipped_form_factor(self, frame, p):
         """Lambert's form factor clipped exactly at the horizon (``polygon.QUAD_FORM_FACTOR_CLIPPED``)."""
         args = {f"p{i}": polygon.frame_coordinates(frame, q - p) for i, q in enumerate(self.corner_list())}
         args["Center"] = polygon.frame_coordinates(frame, self.center() - p)
         args["Two Sided"] = self.two_sided
-        return polygon.QUAD_FORM_FACTOR_CLIPPED(**args)["Integral"]
+        return self.spread_weighted(polygon.QUAD_FORM_FACTOR_CLIPPED(**args)["Integral"], IDENTITY, frame, p)
+
+    def spread_weighted(self, value, c, frame, p):
+        """``value`` (the integral of the LTC with packed Minv c over the light) times the spread's weight averaged
+        under that LTC (``light_spread.lobe_average``); ``value`` itself for a light without spread."""
+        if self.spread is None:
+            return value
+        corners = self.corner_list()
+        axis_u, axis_v = op.scale(corners[1] - corners[0], 0.5), op.scale(corners[3] - corners[0], 0.5)
+        return value * light_spread.lobe_average(self.spread, "quad", self.center(), axis_u, axis_v, p,
+                                                 _lobe_space(c, frame))
+
+
+def _lobe_space(c, frame):
+    """The linear map from world vectors into an LTC's space: the shading frame's coordinates, then Minv."""
+    return lambda d: matrix.transform_packed(c, polygon.frame_coordinates(frame, d))
 
 
 @dataclass(frozen=True)
 class DiskLight:
     """An ellipse (disk when |axis_u| = |axis_v|): centre and semi-axis vectors (arrays (..., 3) or Expr
-    vectors).  One-sided lights emit on the side away from which axis_u x axis_v points (as ``QuadLight``)."""
+    vectors).  One-sided lights emit on the side away from which axis_u x axis_v points (as ``QuadLight``);
+    ``spread`` as ``QuadLight``'s."""
     center: object
     axis_u: object
     axis_v: object
     two_sided: object = False
     exact_horizon: bool = False
+    spread: object = None
 
     def integral(self, tables, c, frame, p, exact_horizon=None):
         """As ``QuadLight.integral``; ``exact_horizon``: ``disk.LTC_DISK_INTEGRAL_CLIPPED``."""
@@ -98,7 +118,14 @@ class DiskLight:
                      "Axis V": polygon.frame_coordinates(frame, self.axis_v),
                      "Two Sided": self.two_sided})
         fn = disk.LTC_DISK_INTEGRAL_CLIPPED if exact_horizon else disk.LTC_DISK_INTEGRAL
-        return fn(tables, **args)["Integral"]
+        return self.spread_weighted(fn(tables, **args)["Integral"], c, frame, p)
+
+    def spread_weighted(self, value, c, frame, p):
+        """As ``QuadLight.spread_weighted``, the average over the ellipse."""
+        if self.spread is None:
+            return value
+        return value * light_spread.lobe_average(self.spread, "disk", self.center, self.axis_u, self.axis_v, p,
+                                                 _lobe_space(c, frame))
 
 
 def lobe_integral(tables, prefix, light, p, n, v, roughness):
@@ -304,8 +331,13 @@ def wrapped_light(light, p, n, wrap):
 
 
 def cod_wrapped_diffuse(tables, light, p, n, v, roughness, albedo, wrap):
-    """Multiscattering wrapped diffuse over an area light: the CoD LTC over the light's image under the wrap."""
+    """Multiscattering wrapped diffuse over an area light: the CoD LTC over the light's image under the wrap (a
+    light with spread: times the spread's weight averaged under the cosine about the wrapped normal, as
+    ``wrapped_diffuse`` weights it; the image is another region of the plane)."""
     value = cod_diffuse(tables, wrapped_light(light, p, n, wrap), p, n, v, roughness, albedo)
+    if light.spread is not None:
+        n_wrapped = diffuse.wrapped_normal(n, op.normalize(light_center(light) - p), wrap)
+        value = light.spread_weighted(value, IDENTITY, polygon.local_frame(n_wrapped, v), p)
     return op.select(op.greater(light_shines(light, p), 0.5), value, 0.0)
 
 

@@ -196,12 +196,13 @@ def shade_function(kind, features):
     if kind != "sun":
         inputs["Position"] = GEOMETRY_INPUTS["Position"]
     inputs.update(lobes.light_geometry_sockets(kind))
-    inputs[color_name] = lights.LIGHT_DATA[kind].output_sockets[color_name]
+    inputs[color_name] = lights.LIGHT_DATA[lights.base_kind(kind)].output_sockets[color_name]
     # only the inputs some lobe or the combination reads
     used = set(surface_terms) | {color_name}.union(*(fn.input_sockets for fn in functions))
     inputs = {k: v for k, v in inputs.items() if k in used}
-    title = {"quad_spot": "Quad Spot Fallback"}.get(kind, kind.capitalize())
-    title = title if kind not in lobes.AREA_KINDS else f"{title} Area"
+    base, options = lights.split_kind(kind)
+    title = {"quad_spot": "Quad Spot Fallback"}.get(base, base.capitalize())
+    title = title if base not in lobes.AREA_KINDS else f"{title} Area" + (" Spread" if options else "")
     return NodeFunction(f"RTL Shade {title} ({features.label()})", shade, inputs,
                         {"Radiance": color((0.0, 0.0, 0.0), "Radiance towards the viewer from this light")},
                         f"One {kind} light on the RT Lit material ({features.label()})", tables=REFERENCES)
@@ -209,9 +210,12 @@ def shade_function(kind, features):
 
 def shading_kind(kind):
     """The kind whose shade function shades ``kind``: its base kind, "disk" for the lights shaded as the disk facing
-    the point (sphere lights, suns with an angle: their data functions give a disk's outputs)."""
-    base = lights.base_kind(kind)
-    return "disk" if base not in lobes.AREA_KINDS and lights.shading_form(base) == "disk" else base
+    the point (sphere lights, suns with an angle: their data functions give a disk's outputs), with "+spread" for an
+    area light with spread (its lobes weight their integrals by the spread: core/light_spread.py)."""
+    base, options = lights.split_kind(kind)
+    if base not in lobes.AREA_KINDS:
+        return "disk" if lights.shading_form(base) == "disk" else base
+    return lights.kind_name(base, ("spread",) if "spread" in options else ())
 
 
 def shade_light(tables, kind, features, surface, position, light):

@@ -70,7 +70,9 @@ class Lobe:
         change the light's data, not its lobes); ``exact_horizon``: area lights clipped at the horizon, else the
         sphere table (``Features.horizon``)."""
         form = lights.shading_form(kind)
-        return _lobe_function(self.key, form, bool(exact_horizon) or form == "punctual")
+        spread = form != "punctual" and "spread" in lights.split_kind(kind)[1]
+        return _lobe_function(self.key, lights.kind_name(form, ("spread",) if spread else ()),
+                              bool(exact_horizon) or form == "punctual")
 
 
 def punctual_cosines(n, v, l):
@@ -331,15 +333,19 @@ LOBES.update({lobe.key: lobe for lobe in (ZELTNER, DISNEY_FITTED)})
 # --- node functions -----------------------------------------------------------------------------------
 
 def _area_light(kind, kw, exact_horizon):
-    if kind == "quad":
+    """The ``core.ltc.shading`` light of an area kind ("quad", "disk", with or without "+spread") from its data."""
+    base, options = lights.split_kind(kind)
+    spread = lights.spread_cone(kw) if "spread" in options else None
+    if base == "quad":
         return shading.QuadLight([kw["p0"], kw["p1"], kw["p2"], kw["p3"]], center_point=kw["Center"],
-                                 exact_horizon=exact_horizon)
-    return shading.DiskLight(kw["Center"], kw["Axis U"], kw["Axis V"], exact_horizon=exact_horizon)
+                                 exact_horizon=exact_horizon, spread=spread)
+    return shading.DiskLight(kw["Center"], kw["Axis U"], kw["Axis V"], exact_horizon=exact_horizon, spread=spread)
 
 
 def light_geometry_sockets(kind):
-    """The geometry outputs of the light's data function (all but its radiance or irradiance)."""
-    data = lights.LIGHT_DATA[lights.base_kind(kind)]
+    """The geometry outputs of the light's data function (all but its radiance or irradiance; a light with spread:
+    its cone, ``lights.SPREAD_OUTPUTS``)."""
+    data = lights.light_data(kind)
     return {n: s for n, s in data.output_sockets.items() if n not in ("Radiance", "Irradiance")}
 
 
@@ -351,7 +357,8 @@ def _lobe_function(key, kind, exact_horizon):
         body = lobe.punctual if lobe.reads_tables_punctual else functools.partial(lobe.punctual, None)
         return NodeFunction(f"RTL Punctual {lobe.title}", body, dict({"N": _N, "V": _V, "L": _L}, **params),
                             lobe.outputs, lobe.punctual_text, tables=REFERENCES if lobe.reads_tables_punctual else None)
-    if kind not in AREA_KINDS:
+    base, options = lights.split_kind(kind)
+    if base not in AREA_KINDS or set(options) - {"spread"}:
         raise ValueError(f"unknown light kind {kind!r}")
     geometry = light_geometry_sockets(kind)
 
@@ -361,8 +368,10 @@ def _lobe_function(key, kind, exact_horizon):
 
     inputs = dict({"Position": _P, "N": _N, "V": _V}, **geometry, **params)
     suffix = "" if exact_horizon else " (Sphere Table Horizon)"
-    return NodeFunction(f"RTL {kind.capitalize()} {lobe.title}{suffix}", body, inputs, lobe.outputs,
-                        lobe.area_text + ("" if exact_horizon else "; the sphere table's horizon (the talk's)"),
+    spread = " Spread" if options else ""
+    return NodeFunction(f"RTL {base.capitalize()}{spread} {lobe.title}{suffix}", body, inputs, lobe.outputs,
+                        lobe.area_text + ("" if exact_horizon else "; the sphere table's horizon (the talk's)")
+                        + ("; each integral weighted by the spread's weight under its lobe" if options else ""),
                         tables=REFERENCES)
 
 

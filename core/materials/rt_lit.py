@@ -82,8 +82,8 @@ def _shade_light(tables, features, surface, position, kind, params):
     """Radiance from one scene light of ``kind`` with driver ``params``: its data function, then its shading."""
     data_fn = lights.light_data(kind)
     args = dict(params)
-    shading_point = {"Position": position, "Normal": surface["N"]}
-    args.update({k: v for k, v in shading_point.items() if k in data_fn.input_sockets})
+    if "Position" in data_fn.input_sockets:
+        args["Position"] = position
     return light_shading.shade_light(tables, kind, features, surface, position, data_fn(**args))
 
 
