@@ -836,7 +836,7 @@ def spread_geometry(base, light, position, spread):
     return out
 
 
-def spread_cone(light):
+def spread_cone_of(light):
     """The ``light_spread.SpreadCone`` in the outputs of a light with spread (``spread_geometry``)."""
     return light_spread.SpreadCone(light["Spread Foot"], light["Spread Radius"], light["Spread Scale"])
 

@@ -335,7 +335,7 @@ LOBES.update({lobe.key: lobe for lobe in (ZELTNER, DISNEY_FITTED)})
 def _area_light(kind, kw, exact_horizon):
     """The ``core.ltc.shading`` light of an area kind ("quad", "disk", with or without "+spread") from its data."""
     base, options = lights.split_kind(kind)
-    spread = lights.spread_cone(kw) if "spread" in options else None
+    spread = lights.spread_cone_of(kw) if "spread" in options else None
     if base == "quad":
         return shading.QuadLight([kw["p0"], kw["p1"], kw["p2"], kw["p3"]], center_point=kw["Center"],
                                  exact_horizon=exact_horizon, spread=spread)
