@@ -632,17 +632,26 @@ def test_spread_on_a_lambert_receiver(energy_tables):
     assert np.median(errors) <= 0.01 and errors.max() <= 0.08
 
 
-def test_spread_weights_each_lobe_under_its_own_kernel(energy_tables):
+@pytest.mark.parametrize("roughness, spread_deg, cases, median_limit, p90_limit", [
+    (0.4, None, 40, 0.005, 0.03),
+    (0.1, 60.0, 80, 0.01, 0.2),
+])
+def test_spread_weights_each_lobe_under_its_own_kernel(energy_tables, roughness, spread_deg, cases, median_limit,
+                                                       p90_limit):
     """Issue 27: a glossy lobe sees the spread's weight near its reflection, not where Lambert's cosine puts it.
-    The GGX LTC at r = 0.4 over 40 seeded quads with spread, views near the mirror direction of a point of the light,
-    against the dense integral of the same LTC times the weight (so the figure is the spread's handling alone):
-    median <= 0.5%, p90 <= 3% (measured 0.2% / 1.2%; weighting by Lambert's kernel, as before: 7% / 53%)."""
+    The GGX LTC over ``cases`` seeded quads with spread (30-160 deg, or ``spread_deg``), views near the mirror direction of
+    a point of the light, against the dense integral of the same LTC times the weight (so the figure is the spread's
+    handling alone).  r = 0.4: median <= 0.5%, p90 <= 3% (measured 0.02% / 0.8%; 5 x 5 plain: 0.06% / 1.7%; weighting by Lambert's kernel,
+    as before issue 27: 7% / 53%).  r = 0.1 at 60 deg, a lobe narrower than the plain 5 x 5 rule's spacing: median
+    <= 1%, p90 <= 20% (measured 0.34% / 9.7% with the rule warped towards the lobe's peak; the plain 5 x 5 rule: 5.4% / 54%)."""
     from rt_lookdev.core.ltc import matrix, polygon
 
     rng = np.random.default_rng(27)
     errors = []
-    for _ in range(40):
+    for _ in range(cases):
         position, normal, centre, half_u, half_v, spread = _spread_case(rng)
+        if spread_deg is not None:
+            spread = np.radians(spread_deg)
         target = centre + rng.uniform(-1, 1) * half_u + rng.uniform(-1, 1) * half_v - position
         target /= np.linalg.norm(target)
         view = 2 * (normal @ target) * normal - target + rng.normal(scale=0.15, size=3)
@@ -651,7 +660,7 @@ def test_spread_weights_each_lobe_under_its_own_kernel(energy_tables):
             continue
         light, hits = _spread_light(position, centre, half_u, half_v, spread)
         frame = polygon.local_frame(normal, view)
-        packed, _, _ = energy_tables.ltc("ltc_ggx", np.array(view @ normal), np.array(0.4))
+        packed, _, _ = energy_tables.ltc("ltc_ggx", np.array(view @ normal), np.array(roughness))
         c = np.array([float(x) for x in packed])
         value = light.integral(energy_tables, tuple(c), frame, position) * hits
         basis = np.stack(frame)
@@ -661,7 +670,7 @@ def test_spread_weights_each_lobe_under_its_own_kernel(energy_tables):
         if truth > 1e-3:
             errors.append(abs(value / truth - 1))
     errors = np.array(errors)
-    print(f"spread, GGX r 0.4: median {np.median(errors):.3%}, p90 {np.percentile(errors, 90):.3%} "
+    print(f"spread, GGX r {roughness}: median {np.median(errors):.3%}, p90 {np.percentile(errors, 90):.3%} "
           f"over {len(errors)}")
     assert len(errors) >= 20
-    assert np.median(errors) <= 0.005 and np.percentile(errors, 90) <= 0.03
+    assert np.median(errors) <= median_limit and np.percentile(errors, 90) <= p90_limit
