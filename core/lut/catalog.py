@@ -115,6 +115,19 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
     GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=_params,
                                 sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_prefix, ()))
 
+#: The drop-in GGX pair (issue 32): ``ltc_ggx``'s lobe fitted as one standalone LTC in every column, for engines that
+#: read only ltc_code's ``ltc_1`` / ``ltc_2`` and so ignore the band (core/export/luts.py, the ``ltc_code`` layout).
+#: Refitted, not copied: the same fit and settings as ``ltc_ggx`` without its band (``LTC_FIT``; core/ltc/fit.py,
+#: ``fit_table`` with ``band=None``).  Every column's fit is independent of the others', so below the band
+#: (r < 0.65, columns 0-40) the values equal ``ltc_ggx``'s to the bit (tests/core/test_ltc_single.py); from r = 0.65 on
+#: they are the best single LTC under the fit's objective (L1 of the density difference, the TV distance), where
+#: ``ltc_ggx`` holds the base fit of its band.  Not read by shading (which uses the band): only exported.
+SINGLE_LTC = {"ltc_ggx_single": ("ltc_ggx", "ggx", "single-scattering GGX (F = 1, height-correlated Smith G2), one "
+                                                   "standalone LTC per cell (no band): ltc_code's drop-in")}
+for _prefix, (_of, _lobe, _text) in SINGLE_LTC.items():
+    GROUPS[_prefix] = BakeGroup(name=_prefix, generator_version=1, params=dict(LTC_FIT, lobe=_lobe),
+                                sources=_LTC_SOURCES + _LTC_BRDF_SOURCES.get(_of, ()))
+
 #: Cycles' sheen (Zeltner, Burley & Chiang 2022): the LTC (a, b) and albedo of each (mu, r), measured from
 #: Cycles renders (validation/benchmarks/sheen_table.py); 32 x 32 nodes at i/31 as Cycles' own table, so a bilinear
 #: lookup reproduces Cycles' exactly.  ``params`` say what was measured, with which Blender.
@@ -193,6 +206,16 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
         name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
         channels=ltc_mag_channels(_prefix),
         description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
+        axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
+
+for _prefix, (_of, _lobe, _text) in SINGLE_LTC.items():
+    TABLES[_prefix + "_inv"] = TableSpec(
+        name=_prefix + "_inv", filename=_prefix + "_inv.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
+        channels=LTC_INV_CHANNELS, description=f"LTC inverse matrix fitted to {_text}",
+        axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
+    TABLES[_prefix + "_mag"] = TableSpec(
+        name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
+        channels=LTC_MAG_CHANNELS, description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
 
 #: The rough-diffuse table's u axis is the diffuse roughness (Principled "Diffuse Roughness"), not the GGX one.
