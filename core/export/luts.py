@@ -2,15 +2,17 @@
 
     export(out, lut_dir=None, formats=FORMATS, precisions=PRECISIONS, layout="rtl", progress=None)
 
-Tables (``layout_tables``): the three GGX energy tables, the three LTC pairs and the horizon-clipped
-sphere table on its own; in the ``rtl`` layout under the catalog's names (core/lut/catalog.py), in the
-``ltc_code`` layout the LTC pairs packed as selfshadow/ltc_code's published ``ltc_1`` / ``ltc_2``
-(Heitz et al. 2016): the same channel order (``ltc_1`` = Minv_xx, Minv_zx, Minv_xz, Minv_zz of the
-inverse matrix normalised by its middle element; ``ltc_2`` = magnitude, Fresnel, 0, sphere table),
-the same axes (x = roughness r, y = sqrt(1 - cos theta_v), texel centres) and the same memory order (flat
-index a + 64 t, row t = 0 first), so an engine that reads the published tables swaps ours in unchanged.
-One addition: the GGX pair's ``ltc_2`` carries the band's weight in B (ltc_code leaves it 0; docs/luts.md,
-``ltc_ggx_mag``): the lobe is (1 - B) LTC(Minv) + B LTC(Minv diag(1, 1, k)), k in the table's channel text.
+Tables (``layout_tables``): the three GGX energy tables, the LTC pairs and the horizon-clipped sphere table on its
+own; in the ``rtl`` layout under the catalog's names (core/lut/catalog.py; ``ltc_ggx`` with its band, and
+``ltc_ggx_single``), in the ``ltc_code`` layout the LTC pairs packed as selfshadow/ltc_code's published ``ltc_1`` /
+``ltc_2`` (Heitz et al. 2016): the same channel order (``ltc_1`` = Minv_xx, Minv_zx, Minv_xz, Minv_zz of the
+inverse matrix normalised by its middle element; ``ltc_2`` = magnitude, Fresnel, 0, sphere table), the same axes
+(x = roughness r, y = sqrt(1 - cos theta_v), texel centres) and the same memory order (flat index a + 64 t, row t = 0
+first), so an engine that reads the published tables swaps ours in unchanged.  The ``ltc_code`` GGX pair is a
+**standalone fit in every column** (``ltc_ggx_single``, issue 32): RT Lit's ``ltc_ggx`` holds, for r >= 0.65, the
+base LTC of its band, which an engine reading only ``ltc_1`` / ``ltc_2`` would use without the band's second LTC and
+so be worse than a table fitted without one (docs/area_lights.md, "Engines that ignore B").  Below r = 0.65 the two
+are the same fit, to the bit.
 
 Formats (one file per table and precision, unless noted): ``exr`` (OpenEXR scanline, ZIP, FLOAT or HALF
 channels), ``ktx2`` (KTX 2.0, RGBA16F / RGBA32F; core/export/containers.py), ``dds`` (DDS with the DX10
@@ -18,10 +20,22 @@ header), ``npz`` (one file per precision: an array per table and the manifest), 
 precision: float arrays, IEEE half as uint16, sizes and layout as constants), ``glsl`` / ``hlsl`` (one
 include per precision: each table's lookup function written by the shader-text backend).
 
-Half precision: a channel whose values would fall below the smallest normal half (6.1e-5) is stored
-multiplied by a power of two (``decode_scale`` in the manifest: value = stored x decode_scale; exact in
-float32), chosen so the channel's largest value stays below 2^15; the lookup functions of the includes
-multiply it back.  Errors against float32 are measured per table and written in the manifest.
+Row order (``ROW_ORDER``, per format, the same in both layouts; recorded per file in the manifest as ``row_order``):
+EXR files store the last table row (v = 1) first, the order in which OpenEXR displays an increasing-y file and in
+which three.js' ``EXRLoader`` (it writes scanline y to row H - 1 - y of its data texture, which is not flipped on
+upload) and Blender place it at v = 1; KTX 2.0 and DDS store table row 0 (v = 0) first, as a texImage2D upload of
+their level places it.  docs/luts.md, "Which engine reads which file", says which engines read which file, from
+their loaders' sources (what is verified there and what is inferred).
+
+Half precision (``HALF_ENCODING``, per layout; ``half_encoding`` in the manifest): in the ``rtl`` layout a channel
+whose values would fall below the smallest normal half (6.1e-5) is stored multiplied by a power of two
+(``decode_scale`` in the manifest: value = stored x decode_scale; exact in float32), chosen so the channel's
+largest value stays below 2^15; the lookup functions of the includes multiply it back.  In the ``ltc_code``
+layout half values are stored **plain** (decode_scale 1), as an engine that reads the published tables expects
+(three.js converts them with ``DataUtils.toHalfFloat`` and reads them as values): round to nearest, relative error
+<= 2^-11 for normal values, absolute <= 2^-25 below 6.1e-5 (IEEE 754 binary16).  The errors against float32 are
+measured per table and written in the manifest (``precision_vs_f32``: ``as_exported``, ``f16_plain``,
+``f16_scaled``).
 
 Output goes to a temporary folder beside ``out`` and replaces ``out`` only when complete, so an
 interrupted export leaves the previous export (or nothing).  ``out`` must be empty, absent, or an
@@ -58,6 +72,19 @@ HALF_EPSILON = 2.0 ** -11            # half's relative rounding bound (round to 
 HALF_SUBNORMAL_STEP = 2.0 ** -24
 SCALE_CEILING = 2.0 ** 15            # scaled channels stay below this
 SPHERE_TABLE = "ltc_sphere"
+#: The ltc_code layout's GGX pair (``ltc_1`` / ``ltc_2``): the standalone fit in every column (catalog.SINGLE_LTC).
+LTC_CODE_GGX_SOURCE = "ltc_ggx_single"
+#: Half tables per layout: rtl scales small channels (``decode_scale``), ltc_code stores plain values (a drop-in).
+HALF_ENCODING = {"rtl": "scaled", "ltc_code": "plain"}
+#: Row order of the files, per format (the same in both layouts): ``v_descending``, the first stored row is the last
+#: table row (v = 1), as OpenEXR's loaders in three.js and Babylon.js and Blender's image orientation place it (they put
+#: the first scanline of an increasing-y file at the top, v = 1); ``v_ascending``, the first stored row is table row 0
+#: (v = 0), as texImage2D uploads a KTX 2.0 or DDS level (docs/luts.md, "Which engine reads which file").
+ROW_ORDER = {"exr": "v_descending", "ktx2": "v_ascending", "dds": "v_ascending"}
+ENCODING = {"exr": {"f32": "OpenEXR FLOAT (32-bit) channels R, G, B, A", "f16": "OpenEXR HALF (16-bit) channels R, G, B, A"},
+            "ktx2": {"f32": "VK_FORMAT_R32G32B32A32_SFLOAT (109)", "f16": "VK_FORMAT_R16G16B16A16_SFLOAT (97)"},
+            "dds": {"f32": "DXGI_FORMAT_R32G32B32A32_FLOAT (2), DX10 header",
+                    "f16": "DXGI_FORMAT_R16G16B16A16_FLOAT (10), DX10 header"}}
 
 CITATIONS = {
     "energy": ["Kulla & Conty 2017, Revisiting Physically Based Shading at Imageworks",
@@ -90,10 +117,17 @@ class ExportTable:
     axes: dict
     citations: list
     origin: dict
+    #: How the half export stores it: "scaled" (small channels multiplied by a power of two, ``decode_scale``) or
+    #: "plain" (the values themselves, as engines reading a published table expect; the ltc_code layout)
+    half_encoding: str = "scaled"
 
     @property
     def shape(self):
         return self.data.shape[:2]
+
+    def encode(self, precision):
+        """(stored array, decode scales) of this table in ``precision``, with its half encoding."""
+        return encode(self.data, precision, scaled=self.half_encoding == "scaled")
 
 
 # --- the tables --------------------------------------------------------------------------------------
@@ -156,18 +190,25 @@ def layout_tables(luts, layout="rtl"):
         if layout == "rtl":
             out += [_catalog_table(luts, prefix + "_inv"), _catalog_table(luts, prefix + "_mag")]
         else:
+            # the GGX pair is the standalone fit (ltc_ggx_single): an engine reading ltc_1 / ltc_2 has no band
+            source = LTC_CODE_GGX_SOURCE if prefix == "ltc_ggx" else prefix
             name = "ltc" if prefix == "ltc_ggx" else prefix
-            out += [_catalog_table(luts, prefix + "_inv", f"{name}_1"), _catalog_table(luts, prefix + "_mag", f"{name}_2")]
+            out += [_catalog_table(luts, source + "_inv", f"{name}_1"), _catalog_table(luts, source + "_mag", f"{name}_2")]
+    if layout == "rtl":
+        out += [_catalog_table(luts, LTC_CODE_GGX_SOURCE + "_inv"), _catalog_table(luts, LTC_CODE_GGX_SOURCE + "_mag")]
     out += [_catalog_table(luts, n) for n in ("zeltner_sheen", "zeltner_sheen_sh1", "zeltner_sheen_sh2")]
     out.append(_sphere_table(luts))
+    for table in out:
+        table.half_encoding = HALF_ENCODING[layout]
     return out
 
 
 # --- half precision ----------------------------------------------------------------------------------
 
-def decode_scales(data, precision):
-    """Per channel, the power of two the stored values are multiplied by when read (1 for f32)."""
-    if precision == "f32":
+def decode_scales(data, precision, scaled=True):
+    """Per channel, the power of two the stored values are multiplied by when read (1 for f32, and for f16 stored
+    plain: ``scaled`` False)."""
+    if precision == "f32" or not scaled:
         return [1.0] * data.shape[2]
     scales = []
     for c in range(data.shape[2]):
@@ -182,9 +223,9 @@ def decode_scales(data, precision):
     return scales
 
 
-def encode(data, precision):
-    """(stored array in the precision's dtype, decode scales)."""
-    scales = decode_scales(data, precision)
+def encode(data, precision, scaled=True):
+    """(stored array in the precision's dtype, decode scales); ``scaled`` False stores half values plain."""
+    scales = decode_scales(data, precision, scaled)
     stored = (data.astype(np.float64) / np.asarray(scales)).astype(DTYPES[precision])
     if not np.isfinite(stored).all():
         raise LutExportError(f"a table does not fit {precision} (values beyond its range)")
@@ -214,18 +255,29 @@ def precision_errors(table):
                 "values_beyond_half_epsilon": int((rel > HALF_EPSILON * (1 + 1e-6)).sum())}
 
     stored, scales = encode(table.data, "f16")
-    return {"f16_plain": errors(table.data.astype(np.float16)), "f16_scaled": errors(decode(stored, scales)),
-            "decode_scale": scales, "values_below_half_normal": int(((np.abs(table.data) > 0)
-                                                                    & (np.abs(table.data) < HALF_MIN_NORMAL)).sum())}
+    out = {"f16_plain": errors(table.data.astype(np.float16)), "f16_scaled": errors(decode(stored, scales)),
+           "decode_scale": scales, "values_below_half_normal": int(((np.abs(table.data) > 0)
+                                                                   & (np.abs(table.data) < HALF_MIN_NORMAL)).sum())}
+    out["half_encoding"] = table.half_encoding
+    out["as_exported"] = out["f16_" + table.half_encoding]
+    out["decode_scale"] = table.encode("f16")[1]
+    return out
 
 
 # --- files -------------------------------------------------------------------------------------------
 
 def _orientation(fmt, layout):
-    if fmt == "exr" and layout == "rtl":
-        return ("scanline 0 is table row H - 1 (Blender's image orientation: EXR stores the top row first and "
-                "Blender samples v = 0 at the bottom)")
+    """The row order of ``fmt``'s files as words (the same in both layouts: ``ROW_ORDER``)."""
+    if ROW_ORDER[fmt] == "v_descending":
+        return ("scanline 0 is table row H - 1 (v = 1): EXR stores the top row first, and Blender and three.js' "
+                "EXRLoader put it at v = 1")
     return "row 0 first: the first row of the data is table row 0 (v = 0)"
+
+
+def _file_info(table, fmt, precision, layout):
+    return {"file": _file_name(table, fmt, precision), "orientation": _orientation(fmt, layout),
+            "row_order": ROW_ORDER[fmt], "encoding": ENCODING[fmt][precision],
+            "half_encoding": table.half_encoding if precision == "f16" else "none (float32)"}
 
 
 def _file_name(table, fmt, precision):
@@ -233,12 +285,12 @@ def _file_name(table, fmt, precision):
 
 
 def _table_file(table, fmt, precision, layout, manifest_entry):
-    stored, _ = encode(table.data, precision)
+    stored, _ = table.encode(precision)
     if fmt == "exr":
-        rows = np.flipud(stored) if layout == "rtl" else stored
+        rows = np.flipud(stored) if ROW_ORDER["exr"] == "v_descending" else stored
         planes = {c: np.ascontiguousarray(rows[..., i]) for i, c in enumerate("RGBA")}
         attrs = {"rtl.table": table.name, "rtl.layout": layout, "rtl.precision": precision,
-                 "rtl.manifest": containers.json_value(manifest_entry)}
+                 "rtl.row_order": ROW_ORDER["exr"], "rtl.manifest": containers.json_value(manifest_entry)}
         return exr_writer.encode(planes, attrs, "zip", "half" if precision == "f16" else "float")
     if fmt == "ktx2":
         return containers.ktx2_bytes(stored, stored.dtype, {"rtl.table": table.name, "rtl.layout": layout,
@@ -249,7 +301,7 @@ def _table_file(table, fmt, precision, layout, manifest_entry):
 
 
 def _npz_bytes(tables, precision, manifest):
-    arrays = {t.name: encode(t.data, precision)[0] for t in tables}
+    arrays = {t.name: t.encode(precision)[0] for t in tables}
     arrays["manifest_json"] = np.frombuffer(json.dumps(manifest).encode(), np.uint8)
     buf = io.BytesIO()
     np.savez(buf, **arrays)
@@ -257,13 +309,13 @@ def _npz_bytes(tables, precision, manifest):
 
 
 def _entry(table, layout, precision, formats, errors):
-    stored, scales = encode(table.data, precision)
+    stored, scales = table.encode(precision)
     return {"name": table.name, "source_table": table.source, "width": table.shape[1], "height": table.shape[0],
             "channels": table.channels, "description": table.description, "axes": table.axes,
             "units": "dimensionless (albedos, matrix entries, form factors)", "precision": precision,
             "decode_scale": scales, "decode": "value = stored * decode_scale (per channel R, G, B, A)",
-            "files": {fmt: {"file": _file_name(table, fmt, precision), "orientation": _orientation(fmt, layout)}
-                      for fmt in formats if fmt in ("exr", "ktx2", "dds")},
+            "half_encoding": table.half_encoding if precision == "f16" else "none (float32)",
+            "files": {fmt: _file_info(table, fmt, precision, layout) for fmt in formats if fmt in ("exr", "ktx2", "dds")},
             "layout": layout, "layout_version": catalog.LAYOUT_VERSION, "origin": table.origin,
             "content_hash_exported": exr_io.content_hash(decode(stored, scales)), "citations": table.citations,
             "precision_vs_f32": errors}
@@ -281,7 +333,11 @@ def manifest(tables, layout, precisions, formats, generator_version):
             "formats": list(formats), "tables": entries,
             "conventions": {"texel_centres": "node k of N at (k + 0.5) / N", "filtering": "bilinear, clamp to edge, no "
                             "mipmaps (the lookup functions fetch four texels and weight them)",
-                            "rows": "row j of a table covers v in [j / H, (j + 1) / H)"}}
+                            "rows": "row j of a table covers v in [j / H, (j + 1) / H)",
+                            "row_order": {"v_descending": "the first stored row is table row H - 1 (v = 1)",
+                                          "v_ascending": "the first stored row is table row 0 (v = 0)"},
+                            "half_encoding": {"scaled": "value = stored * decode_scale",
+                                              "plain": "value = stored (decode_scale 1)"}}}
 
 
 def _generator_version():
@@ -355,7 +411,7 @@ def export(out, lut_dir=None, formats=FORMATS, precisions=PRECISIONS, layout="rt
             elif fmt == "npz":
                 name, data = f"rtl_luts_{precision}.npz", _npz_bytes(tables, precision, info)
             else:
-                stored = {t.name: encode(t.data, precision)[0] for t in tables}
+                stored = {t.name: t.encode(precision)[0] for t in tables}
                 name, data = lut_code.source_file(tables, fmt, precision, layout, info, stored)
             (tmp / name).write_bytes(data)
             sizes[name] = len(data)
@@ -376,20 +432,22 @@ def manifest_markdown(luts_set):
              "|---|---|---|---|---|---|---|"]
     for layout in LAYOUTS:
         for t in layout_tables(luts_set, layout):
-            scales = ", ".join(str(int(np.log2(x))) for x in decode_scales(t.data, "f16"))
+            scales = ", ".join(str(int(np.log2(x))) for x in t.encode("f16")[1])
             lines.append(f"| {layout} | `{t.name}` | `{t.source}` | {t.shape[1]} x {t.shape[0]} | {t.axes['u']['node']} | "
                          f"{t.axes['v']['node']} | {scales} |")
-    lines += ["", "| format | orientation (rtl layout) | orientation (ltc_code layout) |", "|---|---|---|"]
+    lines += ["", "| format | row order (both layouts) | encoding f32 / f16 | half values (rtl / ltc_code) |",
+              "|---|---|---|---|"]
     for fmt in ("exr", "ktx2", "dds"):
-        lines.append(f"| {fmt} | {_orientation(fmt, 'rtl')} | {_orientation(fmt, 'ltc_code')} |")
+        lines.append(f"| {fmt} | `{ROW_ORDER[fmt]}`: {_orientation(fmt, 'rtl')} | {ENCODING[fmt]['f32']} / "
+                     f"{ENCODING[fmt]['f16']} | {HALF_ENCODING['rtl']} / {HALF_ENCODING['ltc_code']} |")
     return "\n".join(lines)
 
 
 # --- reading back ----------------------------------------------------------------------------------
 
 def read_table_file(path):
-    """The stored (H, W, 4) float32 values of an exported table file (exr, ktx2, dds), in table row order
-    for the rtl layout's EXR (flipped back) and as stored otherwise."""
+    """The stored (H, W, 4) float32 values of an exported table file (exr, ktx2, dds) in table row order (an EXR
+    whose header says ``rtl.row_order`` v_descending, or an rtl-layout EXR of an earlier export, flipped back)."""
     path = Path(path)
     data = path.read_bytes()
     if path.suffix == ".ktx2":
@@ -399,7 +457,8 @@ def read_table_file(path):
     if path.suffix == ".exr":
         attrs, planes = exr_reader.read(path)
         table = np.stack([planes[c] for c in "RGBA"], -1).astype(np.float32)
-        return np.flipud(table) if attrs.get("rtl.layout") == "rtl" else table
+        descending = attrs.get("rtl.row_order", "v_descending" if attrs.get("rtl.layout") == "rtl" else "v_ascending")
+        return np.flipud(table) if descending == "v_descending" else table
     raise LutExportError(f"{path}: not a table file")
 
 

@@ -148,12 +148,16 @@ def test_ltc_code_layout_gives_the_rtl_figures(export_ltc_code, lut_dir):
     from rt_lookdev.validation.benchmarks import ltc_random_lights
 
     rtl = {name: ltc_benchmark.exr_io_read(lut_dir, name) for name in catalog.TABLES if name.startswith("ltc_")}
+    # the ltc_code GGX pair is the standalone fit (ltc_ggx_single, issue 32), the other pairs are rtl's
+    for kind in ("inv", "mag"):
+        rtl[f"ltc_ggx_{kind}"] = rtl[f"ltc_ggx_single_{kind}"]
     swapped = {}
     for prefix in catalog.LTC_LOBES:
         stem = "ltc" if prefix == "ltc_ggx" else prefix
         swapped[prefix + "_inv"] = read_ltc_code_dds(export_ltc_code.folder / f"{stem}_1_f32.dds")
         swapped[prefix + "_mag"] = read_ltc_code_dds(export_ltc_code.folder / f"{stem}_2_f32.dds")
         np.testing.assert_array_equal(swapped[prefix + "_inv"], rtl[prefix + "_inv"])
+        np.testing.assert_array_equal(swapped[prefix + "_mag"], rtl[prefix + "_mag"])
     ours = ltc_random_lights.end_to_end(rtl, None, 10, 5)
     theirs = ltc_random_lights.end_to_end(swapped, None, 10, 5)
     assert json.dumps(ours, sort_keys=True) == json.dumps(theirs, sort_keys=True)
@@ -262,3 +266,83 @@ def test_docs_list_the_exported_tables(lut_dir):
     assert doc[doc.index(begin) + len(begin):doc.index(end)].strip() == table.strip(), (
         "docs/luts.md's export table is out of date; paste core.export.luts.manifest_markdown(LutSet.from_folder()) "
         "between the export-tables markers:\n" + table)
+
+
+# --- issue 32: the ltc_code layout as a drop-in ------------------------------------------------------
+
+def _three_exr_loader_rows(path):
+    """The rows of an EXR as three.js' EXRLoader hands them to WebGL: scanline y goes to data row H - 1 - y of a
+    DataTexture (flipY false), whose data row 0 is v = 0 (examples/jsm/loaders/EXRLoader.js)."""
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        channels = {n: np.array(c.pixels) for n, c in f.channels().items()}
+        header = dict(f.header())
+    scanlines = np.stack([channels[c] for c in "RGBA"], -1).astype(np.float32)
+    return scanlines[::-1], header
+
+
+def test_exr_row_order_is_what_three_exr_loader_expects(export_rtl, export_ltc_code, lut_dir):
+    """Both layouts' EXRs read through three.js' EXRLoader order give table row 0 at v = 0 (the ltc_code ones were
+    upside down before issue 32); KTX 2.0 and DDS hold table row 0 first; the manifest and the header say so."""
+    t = lookup.LutSet.from_folder(lut_dir)
+    for result, name, source in ((export_ltc_code, "ltc_1", "ltc_ggx_single_inv"), (export_rtl, "ltc_ggx_inv", "ltc_ggx_inv")):
+        rows, header = _three_exr_loader_rows(result.folder / f"{name}_f32.exr")
+        np.testing.assert_array_equal(rows, t.array(source))
+        assert header["rtl.row_order"] == "v_descending"
+        files = result.manifest["tables"][f"{name}_f32"]["files"]
+        assert {fmt: f["row_order"] for fmt, f in files.items()} == {"exr": "v_descending", "ktx2": "v_ascending",
+                                                                     "dds": "v_ascending"}
+        np.testing.assert_array_equal(containers.read_ktx2((result.folder / f"{name}_f32.ktx2").read_bytes())[0],
+                                      t.array(source))
+        np.testing.assert_array_equal(luts.read_table_file(result.folder / f"{name}_f32.exr"), t.array(source))
+
+
+def test_ltc_code_half_values_are_plain(export_ltc_code):
+    """Every ltc_code f16 file holds the values themselves (decode scale 1: an engine reads them as values): the f16
+    DDS equals the f32 DDS within half's rounding, 2^-11 relative or 2^-25 absolute below the smallest normal."""
+    m = export_ltc_code.manifest["tables"]
+    for key, entry in m.items():
+        if key.endswith("_f16"):
+            assert entry["decode_scale"] == [1.0] * 4 and entry["half_encoding"] == "plain", key
+            assert entry["precision_vs_f32"]["as_exported"] == entry["precision_vs_f32"]["f16_plain"]
+            assert all(f["half_encoding"] == "plain" for f in entry["files"].values())
+    for name in ("ltc_1", "ltc_2", "ltc_cloth_1", "ggx_one_minus_E"):
+        f32 = read_ltc_code_dds(export_ltc_code.folder / f"{name}_f32.dds") if name.startswith("ltc") else \
+            luts.read_table_file(export_ltc_code.folder / f"{name}_f32.dds").astype(np.float64)
+        f16 = read_ltc_code_dds(export_ltc_code.folder / f"{name}_f16.dds") if name.startswith("ltc") else \
+            luts.read_table_file(export_ltc_code.folder / f"{name}_f16.dds").astype(np.float64)
+        bound = np.maximum(np.abs(f32) * 2.0 ** -11, 2.0 ** -25)
+        assert (np.abs(f16 - f32) <= bound).all(), name
+    e = m["ltc_1_f16"]["precision_vs_f32"]["as_exported"]
+    assert e["max_abs"] < 5e-4 and e["values_beyond_half_epsilon"] <= 100          # measured 4.9e-4, 56 (docs/luts.md)
+
+
+def test_manifest_says_row_order_encoding_and_half_encoding_per_file(export_rtl, export_ltc_code):
+    for result, half in ((export_rtl, "scaled"), (export_ltc_code, "plain")):
+        for key, entry in result.manifest["tables"].items():
+            precision = entry["precision"]
+            assert entry["half_encoding"] == (half if precision == "f16" else "none (float32)")
+            for fmt, f in entry["files"].items():
+                assert f["row_order"] == luts.ROW_ORDER[fmt] and f["encoding"] == luts.ENCODING[fmt][precision]
+                assert f["half_encoding"] == entry["half_encoding"]
+        assert set(result.manifest["conventions"]["row_order"]) == {"v_descending", "v_ascending"}
+
+
+def test_ltc_code_ggx_pair_is_the_standalone_fit(export_ltc_code, lut_dir):
+    """ltc_1 / ltc_2 are ltc_ggx_single (no band weight in B), and in the band's columns (r >= 0.65) they are closer
+    to the GGX lobe on their own than ltc_ggx's base fit (the TV distance, fit.tv_distance)."""
+    from rt_lookdev.core.ltc import fit
+    from rt_lookdev.core.ltc import fit_lobes
+
+    t = lookup.LutSet.from_folder(lut_dir)
+    ltc1 = read_ltc_code_dds(export_ltc_code.folder / "ltc_1_f32.dds")
+    ltc2 = read_ltc_code_dds(export_ltc_code.folder / "ltc_2_f32.dds")
+    np.testing.assert_array_equal(ltc1, t.array("ltc_ggx_single_inv"))
+    assert not ltc2[..., 2].any()
+    cols = np.arange(41, 64, 2)
+    single, base = [], []
+    for row in (0, 24, 48):
+        mu = max(1.0 - (row / 63) ** 2, fit.FIT_MU_MIN)
+        args = (fit_lobes.LOBES["ggx"], mu, cols / 63, ltc2[row, cols, 0])
+        single.append(fit.tv_distance(*args, ltc1[row, cols], n=1 << 12))
+        base.append(fit.tv_distance(*args, t.array("ltc_ggx_inv")[row, cols].astype(np.float64), n=1 << 12))
+    assert (np.array(single) < np.array(base)).all()
