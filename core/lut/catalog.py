@@ -197,7 +197,8 @@ for _name, _channels in (("zeltner_sheen_sh1", "R = E[x], G = E[z], B = E[x z]; 
         description="moments of the Zeltner sheen's normalised LTC per (mu, r) in the local frame (N = +Z, V towards "
                     "+X), derived from zeltner_sheen: the world term's exact L2 SH integral",
         axis_u=TABLES["zeltner_sheen"].axis_u, axis_v=AXIS_V_MU)
-for _prefix, (_lobe, _text) in LTC_LOBES.items():
+_LTC_TEXTS = {**{p: text for p, (_, text) in LTC_LOBES.items()}, **{p: text for p, (_, _, text) in SINGLE_LTC.items()}}
+for _prefix, _text in _LTC_TEXTS.items():
     TABLES[_prefix + "_inv"] = TableSpec(
         name=_prefix + "_inv", filename=_prefix + "_inv.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
         channels=LTC_INV_CHANNELS, description=f"LTC inverse matrix fitted to {_text}",
@@ -206,16 +207,6 @@ for _prefix, (_lobe, _text) in LTC_LOBES.items():
         name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
         channels=ltc_mag_channels(_prefix),
         description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
-        axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
-
-for _prefix, (_of, _lobe, _text) in SINGLE_LTC.items():
-    TABLES[_prefix + "_inv"] = TableSpec(
-        name=_prefix + "_inv", filename=_prefix + "_inv.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
-        channels=LTC_INV_CHANNELS, description=f"LTC inverse matrix fitted to {_text}",
-        axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
-    TABLES[_prefix + "_mag"] = TableSpec(
-        name=_prefix + "_mag", filename=_prefix + "_mag.exr", group=_prefix, width=LTC_SIZE, height=LTC_SIZE,
-        channels=LTC_MAG_CHANNELS, description=f"LTC magnitude and Fresnel of {_text}; sphere table in A",
         axis_v=AXIS_V_SQRT_ONE_MINUS_MU)
 
 #: The rough-diffuse table's u axis is the diffuse roughness (Principled "Diffuse Roughness"), not the GGX one.
