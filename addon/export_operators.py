@@ -19,10 +19,12 @@ _FORMAT_ITEMS = (
     ("glsl", "GLSL include", "each table's lookup function, as the shader backend writes it"),
     ("hlsl", "HLSL include", "each table's lookup function, as the shader backend writes it"),
 )
-_PRECISION_ITEMS = (("f32", "Float32", "32-bit float texels"), ("f16", "Half", "16-bit float texels (scaled where "
-                                                                                 "small values need it: manifest)"))
+_PRECISION_ITEMS = (("f32", "Float32", "32-bit float texels"),
+                    ("f16", "Half", "16-bit float texels (rtl: scaled where small values need it; ltc_code: plain "
+                                    "values; manifest)"))
 _LAYOUT_ITEMS = (("rtl", "RT Lookdev", "the project's tables and names (docs/luts.md)"),
-                 ("ltc_code", "ltc_code", "LTC pairs packed as selfshadow/ltc_code's published ltc_1 / ltc_2"))
+                 ("ltc_code", "ltc_code", "LTC pairs packed as selfshadow/ltc_code's published ltc_1 / ltc_2: a drop-in "
+                  "(standalone GGX fit, plain half values)"))
 
 
 class _FolderExport:

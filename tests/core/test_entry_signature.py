@@ -25,6 +25,7 @@ CONVERTED = {
     "benchmarks/ltc_suite_like": "benchmark_ltc_suite_like.py",
     "benchmarks/lut_benchmark": "benchmark_luts.py",
     "benchmarks/lut_export_benchmark": "benchmark_lut_export.py",
+    "benchmarks/ltc_code_export_benchmark": "benchmark_ltc_code_export.py",
     "benchmarks/metal_split_benchmark": "benchmark_metal_split.py",
     "benchmarks/realtime_benchmark": "benchmark_realtime.py",
     "benchmarks/rt_lit_benchmark": "benchmark_rt_lit.py",

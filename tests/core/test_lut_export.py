@@ -2,7 +2,9 @@
 (exactly in float32, within half's rounding in float16), the containers' fields are the specifications'
 (read here by hand from the byte layout the specs give, not with the writer's reader), OpenEXR reads the
 EXR files, the ltc_code layout reads through a reader written from the published layout description with
-the same end-to-end LTC figures as the rtl layout, and bad requests are refused leaving nothing behind."""
+the same end-to-end LTC figures as the rtl layout (its GGX pair: ltc_ggx_single), the ltc_code layout is a drop-in
+(issue 32: standalone GGX fit, plain half values, EXR rows as three.js' EXRLoader reads them), and bad requests are
+refused leaving nothing behind."""
 from __future__ import annotations
 
 import json
