@@ -23,8 +23,8 @@ light with spread as (this project's construction; docs/blender.md, "Spread"):
 3. the average of w over the region weighted by that lobe's own kernel (``lobe_average``), by a
    Gauss rule on the region: on a quad 5 x 5 Gauss-Legendre points moved towards where the lobe's axis meets
    the quad's plane (``quad_points``: a narrow lobe falls between the plain rule's points), on a disk 3 radial
-   x 6 angular points; exact where w is constant, and where the region is much larger than the cone it finds
-   the cone.
+   x 6 angular points, or for a narrow lobe the quad's warped rule carried onto the disk (``disk_points``);
+   exact where w is constant, and where the region is much larger than the cone it finds the cone.
 
 The kernel of an LTC with inverse matrix Minv, over the light's area, is max((Minv x).z, 0) / |Minv x|^4
 for x the point relative to the shading point in the shading frame (Heitz et al. 2016, eq. 1-4: the
@@ -42,8 +42,12 @@ the same LTC times w (tests/core/test_lights.py checks r = 0.4 at random spreads
 median / p90 / max over 40 quads, spread 60 deg: with each lobe's kernel and the warped 5 x 5 rule, r = 0.1 0.33% /
 11% / 17%, r = 0.4 0.13% / 0.97% / 14%, r = 1 0.25% / 0.85% / 3.5%; the plain 5 x 5 rule (before): 5.7% / 53% / 132%,
 0.21% / 1.6% / 44%, 0.13% / 0.77% / 4.0%; with Lambert's kernel, as before issue 27 (80 quads, random spreads):
-15% / 119% / 4040%, 8.4% / 45% / 119% and 0.66% / 3.0% / 7%.  Disks at r = 0.4 (3 x 6 points): 0.42% / 6.9% /
-12.5% (4 x 8: 0.11% / 3.9% / 12%).
+15% / 119% / 4040%, 8.4% / 45% / 119% and 0.66% / 3.0% / 7%.  Disks of radius 0.3-1 m at 0.6-2 m, spread 90 deg
+(30 receivers; tests/core/test_lights.py checks Lambert and r = 0.1), median / p90: Lambert 1.4% / 8.3%, r = 0.4
+0.81% / 7.2%, r = 1 1.4% / 8.4% (broad lobes: the polar rule; the error is the lens's fitted ellipse, over which the
+weight is averaged: the true lens would need the light's own disk in the lobes' inputs), r = 0.1 1.2% / 15% (the
+warped rule; the polar rule alone 13% / 53%).  Cost: the warped rules add IR operations to each lobe of a light with
+spread (Turquin + CoD, one light: quad 2524 -> 3430, disk 2310 -> 4845; a light without spread is unchanged).
 """
 from __future__ import annotations
 
@@ -123,11 +127,14 @@ KERNEL_FLOOR = 1e-12
 
 
 def _disk_points():
-    return [(r * math.cos(a), r * math.sin(a), wr / len(DISK_ANGLES))
-            for r, wr in zip(DISK_RADII, DISK_RADIAL_WEIGHTS) for a in DISK_ANGLES]
+    """The polar rule (``DISK_RADII`` x ``DISK_ANGLES``), padded with points of weight 0 to the warped rule's count
+    (``disk_points`` picks, per point, this rule's or ``warped_disk_points``')."""
+    points = [(r * math.cos(a), r * math.sin(a), wr / len(DISK_ANGLES))
+              for r, wr in zip(DISK_RADII, DISK_RADIAL_WEIGHTS) for a in DISK_ANGLES]
+    return points + [(0.0, 0.0, 0.0)] * (len(QUAD_NODES) ** 2 - len(points))
 
 
-#: The disk's rule: points (x, y, weight) of ``centre + axis_u x + axis_v y`` over the unit disk.
+#: The disk's polar rule: points (x, y, weight) of ``centre + axis_u x + axis_v y`` over the unit disk.
 DISK_POINTS = _disk_points()
 
 #: The lobe's footprint on the quad's plane, as a fraction of the distance t along the lobe's axis to the plane,
@@ -199,18 +206,66 @@ def quad_points(a, b, e):
     return [(x, y, wx * wy) for x, wx in xs for y, wy in ys]
 
 
+def _square_from_disk(x, y):
+    """The inverse of the elliptical grid map (x, y) -> (x sqrt(1 - y^2 / 2), y sqrt(1 - x^2 / 2)) of the square
+    [-1, 1]^2 onto the unit disk (Fong 2015, "Analytical methods for squaring the disc"), for a point of the disk:
+    x = (sqrt(2 + t + 2 sqrt(2) x) - sqrt(2 + t - 2 sqrt(2) x)) / 2, y likewise with -t and y, t = x^2 - y^2."""
+    t = x * x - y * y
+    k = 2.0 * math.sqrt(2.0)
+    return (0.5 * op.sqrt(2.0 + t + k * x) - 0.5 * op.sqrt(2.0 + t - k * x),
+            0.5 * op.sqrt(2.0 - t + k * y) - 0.5 * op.sqrt(2.0 - t - k * y))
+
+
+#: How far inside the disk's rim (radius 1) the lobe's peak is pulled for the warped disk rule.
+DISK_PEAK_LIMIT = 0.999
+#: A lobe whose footprint (``quad_points``) is below this many of the disk's semi-axes along either axis takes the
+#: warped rule, a broader one the polar rule: exact along the radius for the spread's cone about the disk's centre
+#: (the region is the cone's circle where that lies inside the light), where the warped rule for every lobe put a
+#: Lambert receiver 3% off, the cone's apex between its points (tests/blender/test_light_model.py, spread 40 deg).
+NARROW_FOOTPRINT = 0.5
+
+
+def warped_disk_points(x_peak, y_peak, footprint_x, footprint_y):
+    """The warped rule on the unit disk: ``warped_gauss`` on the square about the square's image of the lobe's peak
+    (pulled into the disk), carried onto the disk by the elliptical grid map, whose Jacobian is
+    (1 - (x^2 + y^2) / 2) / (sqrt(1 - x^2 / 2) sqrt(1 - y^2 / 2)) (0 only at the square's corners)."""
+    radius = op.sqrt(x_peak * x_peak + y_peak * y_peak)
+    pull = op.safe_div(op.minimum(radius, DISK_PEAK_LIMIT), radius)
+    x_square, y_square = _square_from_disk(x_peak * pull, y_peak * pull)
+    xs = [(x, w, op.sqrt(1.0 - 0.5 * x * x)) for x, w in warped_gauss(x_square, footprint_x)]
+    ys = [(y, w, op.sqrt(1.0 - 0.5 * y * y)) for y, w in warped_gauss(y_square, footprint_y)]
+    return [(x * y_stretch, y * x_stretch,
+             wx * wy * op.safe_div(1.0 - 0.5 * (x * x + y * y), x_stretch * y_stretch))
+            for x, wx, x_stretch in xs for y, wy, y_stretch in ys]
+
+
+def disk_points(a, b, e):
+    """The disk's rule for the lobe whose space holds the disk as a + b x + e y: per point, the warped rule's
+    (``warped_disk_points``) where the lobe is narrow (``NARROW_FOOTPRINT``) and faces the disk's plane, else the
+    polar rule's (``DISK_POINTS``)."""
+    x_peak, y_peak, t = lobe_peak(a, b, e)
+    faces = op.greater(t, 0.0)
+    lo, hi = FOOTPRINT_BOUNDS
+    footprint_x = op.select(faces, op.clamp(op.safe_div(FOOTPRINT * t, op.length(b)), lo, hi), hi)
+    footprint_y = op.select(faces, op.clamp(op.safe_div(FOOTPRINT * t, op.length(e)), lo, hi), hi)
+    narrow = op.logical_and(faces, op.less(op.minimum(footprint_x, footprint_y), NARROW_FOOTPRINT))
+    warped = warped_disk_points(op.select(faces, x_peak, 0.0), op.select(faces, y_peak, 0.0), footprint_x, footprint_y)
+    return [(op.select(narrow, xw, xp), op.select(narrow, yw, yp), op.select(narrow, ww, wp))
+            for (xw, yw, ww), (xp, yp, wp) in zip(warped, DISK_POINTS)]
+
+
 def lobe_average(cone, form, centre, axis_u, axis_v, position, to_lobe):
     """The average of the spread weight over the region ``centre + axis_u x + axis_v y`` (a quad, [-1, 1]^2, or a
     disk), weighted by the rule's weight times a lobe's kernel max(m.z, 0) / |m|^4, m = ``to_lobe``(point -
     position) (module docstring; ``to_lobe`` linear: the shading frame's coordinates, then the LTC's Minv); the
-    quad's rule follows the lobe (``quad_points``), the disk's is ``DISK_POINTS``.  Each point's m and its offset
+    rules follow the lobe (``quad_points``, ``disk_points``).  Each point's m and its offset
     from the foot are formed as vectors (expanding their squared lengths into dot products of the three vectors
     cancels in float32 near the foot); the three vectors in the lobe's space are normalised by their size first
     (the average does not depend on it; a light 1e-6 m or 1e6 m away stays finite in float32)."""
     a, b, e = to_lobe(centre - position), to_lobe(axis_u), to_lobe(axis_v)
     inv_size = op.inverse_sqrt(op.dot(a, a) + op.dot(b, b) + op.dot(e, e), 1e-30)
     a, b, e = op.scale(a, inv_size), op.scale(b, inv_size), op.scale(e, inv_size)
-    points = quad_points(a, b, e) if form == "quad" else DISK_POINTS
+    points = quad_points(a, b, e) if form == "quad" else disk_points(a, b, e)
     g = centre - cone.foot
     total, weighted = 0.0, 0.0
     for x, y, w in points:

@@ -595,6 +595,15 @@ def _spread_case(rng):
     return position, normal, np.array([0, 0, height]), half_u, half_v, spread
 
 
+def _view_near_mirror(rng, normal, target):
+    """A seeded view direction near the mirror of ``target`` (towards a point of the light) about ``normal``, or None
+    where it grazes the surface."""
+    target = target / np.linalg.norm(target)
+    view = 2 * (normal @ target) * normal - target + rng.normal(scale=0.15, size=3)
+    view /= np.linalg.norm(view)
+    return None if view @ normal < 0.05 else view
+
+
 def _spread_light(position, centre, half_u, half_v, spread, exact_horizon=True):
     """The QuadLight RT Lit shades for a light with spread (core/lights.py ``spread_geometry``) and its hits."""
     from rt_lookdev.core.ltc import shading
@@ -652,11 +661,9 @@ def test_spread_weights_each_lobe_under_its_own_kernel(energy_tables, roughness,
         position, normal, centre, half_u, half_v, spread = _spread_case(rng)
         if spread_deg is not None:
             spread = np.radians(spread_deg)
-        target = centre + rng.uniform(-1, 1) * half_u + rng.uniform(-1, 1) * half_v - position
-        target /= np.linalg.norm(target)
-        view = 2 * (normal @ target) * normal - target + rng.normal(scale=0.15, size=3)
-        view /= np.linalg.norm(view)
-        if view @ normal < 0.05:
+        view = _view_near_mirror(rng, normal, centre + rng.uniform(-1, 1) * half_u + rng.uniform(-1, 1) * half_v
+                                 - position)
+        if view is None:
             continue
         light, hits = _spread_light(position, centre, half_u, half_v, spread)
         frame = polygon.local_frame(normal, view)
@@ -673,4 +680,59 @@ def test_spread_weights_each_lobe_under_its_own_kernel(energy_tables, roughness,
     print(f"spread, GGX r {roughness}: median {np.median(errors):.3%}, p90 {np.percentile(errors, 90):.3%} "
           f"over {len(errors)}")
     assert len(errors) >= 20
+    assert np.median(errors) <= median_limit and np.percentile(errors, 90) <= p90_limit
+
+
+def _disk_spread_truth(position, radius, height, spread, density, radial=200, angular=400):
+    """Exact integral over a disk light (centre (0, 0, height), emitting down) of ``density`` times Cycles' spread
+    weight per solid angle: a polar midpoint rule."""
+    r = (np.arange(radial) + 0.5) / radial * radius
+    rr, aa = np.meshgrid(r, (np.arange(angular) + 0.5) / angular * 2 * np.pi)
+    q = np.stack([(rr * np.cos(aa)).ravel(), (rr * np.sin(aa)).ravel(), np.full(rr.size, height)], -1)
+    d = q - position
+    r2 = np.sum(d * d, -1)
+    w = d / np.sqrt(r2)[:, None]
+    area = rr.ravel() * (radius / radial) * (2 * np.pi / angular)
+    return float(np.sum(_spread_weight(q, position, spread) * density(w) * w[:, 2] / r2 * area))
+
+
+@pytest.mark.parametrize("lobe, median_limit, p90_limit", [("lambert", 0.02, 0.10), ("ggx r 0.1", 0.03, 0.25)])
+def test_spread_on_a_disk(energy_tables, lobe, median_limit, p90_limit):
+    """Issue 27: a disk light with spread 90 deg (radius 0.3-1 m at 0.6-2 m, 30 seeded receivers viewing near the
+    mirror direction of a point of the light), its LTC integral times the spread's average under the lobe's kernel
+    against the dense integral of the same LTC times the weight.  Lambert: median <= 2%, p90 <= 10% (measured 1.4% /
+    8.3%: the lens of a disk and the cone's circle taken as a fitted ellipse); GGX r = 0.1: median <= 3%, p90 <= 25%
+    (measured 1.2% / 15% with the warped rule for narrow lobes; the polar rule alone, before: 13% / 53%)."""
+    from rt_lookdev.core.ltc import matrix, polygon, shading
+
+    rng = np.random.default_rng(5)
+    spread = np.radians(90.0)
+    errors = []
+    while len(errors) < 30:
+        radius, height = rng.uniform(0.3, 1.0), rng.uniform(0.6, 2.0)
+        position = np.array([rng.uniform(-1.2, 1.2), rng.uniform(-1.2, 1.2), 0.0])
+        normal = rng.normal(size=3)
+        normal[2] = abs(normal[2]) + 0.8
+        normal /= np.linalg.norm(normal)
+        centre, axis_u, axis_v = np.array([0, 0, height]), np.array([radius, 0, 0]), np.array([0, radius, 0])
+        view = _view_near_mirror(rng, normal, centre + rng.uniform(-0.7, 0.7) * axis_u
+                                 + rng.uniform(-0.7, 0.7) * axis_v - position)
+        if view is None:
+            continue
+        c_, u_, v_, cone, hits = lights.light_spread.spread_disk(position, centre, axis_u, axis_v, spread)
+        light = shading.DiskLight(c_, u_, v_, exact_horizon=True, spread=cone)
+        frame = polygon.local_frame(normal, view)
+        if lobe == "lambert":
+            c = np.array([1.0, 0.0, 0.0, 1.0])       # Minv = I: the clamped cosine
+        else:
+            packed, _, _ = energy_tables.ltc("ltc_ggx", np.array(view @ normal), np.array(0.1))
+            c = np.array([float(x) for x in packed])
+        value = float(light.integral(energy_tables, tuple(c), frame, position) * hits)
+        basis = np.stack(frame)
+        truth = _disk_spread_truth(position, radius, height, spread,
+                                   lambda w: matrix.density_packed(c[None], w @ basis.T)[0])
+        if truth > 1e-3:
+            errors.append(abs(value / truth - 1))
+    errors = np.array(errors)
+    print(f"spread on a disk, {lobe}: median {np.median(errors):.3%}, p90 {np.percentile(errors, 90):.3%}")
     assert np.median(errors) <= median_limit and np.percentile(errors, 90) <= p90_limit
