@@ -23,8 +23,10 @@ light with spread as (this project's construction; docs/blender.md, "Spread"):
 3. the average of w over the region weighted by that lobe's own kernel (``lobe_average``), by a
    Gauss rule on the region: on a quad 5 x 5 Gauss-Legendre points moved towards where the lobe's axis meets
    the quad's plane (``quad_points``: a narrow lobe falls between the plain rule's points), on a disk 3 radial
-   x 6 angular points, or for a narrow lobe the quad's warped rule carried onto the disk (``disk_points``);
-   exact where w is constant, and where the region is much larger than the cone it finds the cone.
+   x 8 angular points about the foot over the light's own disk cut by the cone's circle (``lens_samples``:
+   the region shaded there is an ellipse fitted to that lens), or for a narrow lobe the quad's warped rule
+   carried onto the disk (``warped_disk_rule``); exact where w is constant, and where the region is much larger
+   than the cone it finds the cone.
 
 The kernel of an LTC with inverse matrix Minv, over the light's area, is max((Minv x).z, 0) / |Minv x|^4
 for x the point relative to the shading point in the shading frame (Heitz et al. 2016, eq. 1-4: the
@@ -43,16 +45,16 @@ median / p90 / max over 40 quads, spread 60 deg: with each lobe's kernel and the
 11% / 17%, r = 0.4 0.13% / 0.97% / 14%, r = 1 0.25% / 0.85% / 3.5%; the plain 5 x 5 rule (before): 5.7% / 53% / 132%,
 0.21% / 1.6% / 44%, 0.13% / 0.77% / 4.0%; with Lambert's kernel, as before issue 27 (80 quads, random spreads):
 15% / 119% / 4040%, 8.4% / 45% / 119% and 0.66% / 3.0% / 7%.  Disks of radius 0.3-1 m at 0.6-2 m, spread 90 deg
-(30 receivers; tests/core/test_lights.py checks Lambert and r = 0.1), median / p90: Lambert 1.4% / 8.3%, r = 0.4
-0.81% / 7.2%, r = 1 1.4% / 8.4% (broad lobes: the polar rule; the error is the lens's fitted ellipse, over which the
-weight is averaged: the true lens would need the light's own disk in the lobes' inputs), r = 0.1 1.2% / 15% (the
-warped rule; the polar rule alone 13% / 53%).  Cost: the warped rules add IR operations to each lobe of a light with
-spread (Turquin + CoD, one light: quad 2524 -> 3430, disk 2310 -> 4845; a light without spread is unchanged).
+(30 receivers; tests/core/test_lights.py checks Lambert and r = 0.1), median / p90: Lambert 0.36% / 2.7%, r = 0.4
+0.81% / 2.6%, r = 1 0.32% / 2.6% (broad lobes: ``lens_samples`` over the true overlap; averaged over the overlap's
+fitted ellipse with the polar rule, before: 1.4% / 8.3%, 2.6% / 9.1%, 1.4% / 8.4%), r = 0.1 1.2% / 15% (the warped
+rule; the polar rule, before: 13% / 53%).  Cost: the warped rules add IR operations to each lobe of a light with
+spread (Turquin + CoD, one light: quad 2524 -> 3430, disk 2310 -> 6078; a light without spread is unchanged).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -93,10 +95,13 @@ def spread_weight(rho, cone_radius, normalization):
 class SpreadCone:
     """The spread's cone over the light's plane as one shading point sees it: its ``foot`` (the shading point's
     projection on the plane, world space), ``radius`` R = t tan h (t the point's distance from the plane; 1e30 at
-    180 deg: ``FULL_RADIUS``, where the weight is 1 everywhere: Cycles takes tan(h) = FLT_MAX) and ``scale`` c (1 at 180 deg)."""
+    180 deg: ``FULL_RADIUS``, where the weight is 1 everywhere: Cycles takes tan(h) = FLT_MAX) and ``scale`` c (1 at 180 deg);
+    for a disk light, ``disk``: the light's own (centre, axis_u, axis_v), over whose overlap with the cone's circle
+    ``lens_samples`` averages (None: the average is over the region shaded)."""
     foot: object
     radius: object
     scale: object
+    disk: tuple = None
 
     def weight(self, rho):
         """w at the distance rho from the foot."""
@@ -219,9 +224,10 @@ def _square_from_disk(x, y):
 #: How far inside the disk's rim (radius 1) the lobe's peak is pulled for the warped disk rule.
 DISK_PEAK_LIMIT = 0.999
 #: A lobe whose footprint (``quad_points``) is below this many of the disk's semi-axes along either axis takes the
-#: warped rule, a broader one the polar rule: exact along the radius for the spread's cone about the disk's centre
-#: (the region is the cone's circle where that lies inside the light), where the warped rule for every lobe put a
+#: warped rule, a broader one the polar rule about the cone's foot (``lens_samples``; ``DISK_POINTS`` where the cone
+#: does not carry the light's disk): exact along each ray for the cone, where the warped rule for every lobe put a
 #: Lambert receiver 3% off, the cone's apex between its points (tests/blender/test_light_model.py, spread 40 deg).
+#: Validation suite, spread_disk GGX r = 0.4, median: 0.5 4.5%, 1.0 8.7%.
 NARROW_FOOTPRINT = 0.5
 
 
@@ -239,42 +245,107 @@ def warped_disk_points(x_peak, y_peak, footprint_x, footprint_y):
             for x, wx, x_stretch in xs for y, wy, y_stretch in ys]
 
 
-def disk_points(a, b, e):
-    """The disk's rule for the lobe whose space holds the disk as a + b x + e y: per point, the warped rule's
-    (``warped_disk_points``) where the lobe is narrow (``NARROW_FOOTPRINT``) and faces the disk's plane, else the
-    polar rule's (``DISK_POINTS``)."""
+def warped_disk_rule(a, b, e):
+    """(narrow, points): whether the lobe whose space holds the disk as a + b x + e y is narrow (``NARROW_FOOTPRINT``)
+    and faces the disk's plane, and the warped rule's points for it (``warped_disk_points``)."""
     x_peak, y_peak, t = lobe_peak(a, b, e)
     faces = op.greater(t, 0.0)
     lo, hi = FOOTPRINT_BOUNDS
     footprint_x = op.select(faces, op.clamp(op.safe_div(FOOTPRINT * t, op.length(b)), lo, hi), hi)
     footprint_y = op.select(faces, op.clamp(op.safe_div(FOOTPRINT * t, op.length(e)), lo, hi), hi)
     narrow = op.logical_and(faces, op.less(op.minimum(footprint_x, footprint_y), NARROW_FOOTPRINT))
-    warped = warped_disk_points(op.select(faces, x_peak, 0.0), op.select(faces, y_peak, 0.0), footprint_x, footprint_y)
+    return narrow, warped_disk_points(op.select(faces, x_peak, 0.0), op.select(faces, y_peak, 0.0), footprint_x,
+                                      footprint_y)
+
+
+def disk_points(a, b, e):
+    """The disk's rule on the region itself: per point, the warped rule's where the lobe is narrow
+    (``warped_disk_rule``), else the polar rule's (``DISK_POINTS``)."""
+    narrow, warped = warped_disk_rule(a, b, e)
     return [(op.select(narrow, xw, xp), op.select(narrow, yw, yp), op.select(narrow, ww, wp))
             for (xw, yw, ww), (xp, yp, wp) in zip(warped, DISK_POINTS)]
+
+
+#: The lens rule's Gauss-Legendre points: angles about the foot, and along each ray (``lens_samples``).
+LENS_ANGLES, LENS_ANGLE_WEIGHTS = (tuple(float(x) for x in a) for a in np.polynomial.legendre.leggauss(8))
+LENS_RADII, LENS_RADIAL_WEIGHTS = (tuple(float(x) for x in a) for a in np.polynomial.legendre.leggauss(3))
+
+
+def lens_samples(cone, position, to_lobe, inv_size):
+    """(m, weight, spread weight) of a polar rule about the cone's foot over the light's own disk (``cone.disk``) cut
+    by the cone's circle: the angles that see the disk (all, or the 2 asin(1 / d) of a foot d semi-axes outside
+    its bounding circle), on each ray the stretch inside the ellipse (a quadratic in rho) and within R.  The weight
+    is linear along each ray, so this rule finds a disk's overlap with the cone, a lens, exactly where the region
+    shaded is only its fitted ellipse (``spread_disk``).  m in the lobe's space scaled by ``inv_size`` (as
+    ``lobe_average``'s); lengths in units of the disk's larger semi-axis; padded with points of weight 0 to the
+    warped rule's count."""
+    centre, axis_u, axis_v = cone.disk
+    length_u, length_v = op.length(axis_u), op.length(axis_v)
+    size = op.maximum(length_u, length_v)
+    unit_u, unit_v = op.normalize(axis_u), op.normalize(axis_v)
+    inv_u2 = op.safe_div(size * size, length_u * length_u)
+    inv_v2 = op.safe_div(size * size, length_v * length_v)
+    offset = cone.foot - centre
+    foot_u, foot_v = op.safe_div(op.dot(offset, unit_u), size), op.safe_div(op.dot(offset, unit_v), size)
+    reach = op.safe_div(cone.radius, size)
+    distance = op.sqrt(foot_u * foot_u + foot_v * foot_v)
+    half_angle = op.select(op.greater(distance, 1.0), op.asin(op.safe_div(1.0, distance)), math.pi)
+    towards = op.atan2(-foot_v, -foot_u)
+    base = op.scale(to_lobe(cone.foot - position), inv_size)
+    along_u, along_v = op.scale(to_lobe(unit_u), size * inv_size), op.scale(to_lobe(unit_v), size * inv_size)
+    outside = foot_u * foot_u * inv_u2 + foot_v * foot_v * inv_v2 - 1.0
+    samples = []
+    for angle, angle_weight in zip(LENS_ANGLES, LENS_ANGLE_WEIGHTS):
+        phi = towards + half_angle * angle
+        c, s = op.cos(phi), op.sin(phi)
+        # |foot + rho (c, s)| = 1 in the ellipse's metric: q2 rho^2 + q1 rho + outside = 0
+        q2 = c * c * inv_u2 + s * s * inv_v2
+        q1 = 2.0 * (foot_u * c * inv_u2 + foot_v * s * inv_v2)
+        root = op.sqrt(q1 * q1 - 4.0 * q2 * outside)
+        near = op.minimum(op.maximum(op.safe_div(-q1 - root, 2.0 * q2), 0.0), reach)
+        far = op.minimum(op.maximum(op.safe_div(-q1 + root, 2.0 * q2), near), reach)
+        half = (far - near) * 0.5
+        direction = op.scale(along_u, c) + op.scale(along_v, s)
+        for radial, radial_weight in zip(LENS_RADII, LENS_RADIAL_WEIGHTS):
+            rho = near + half + half * radial
+            samples.append((base + op.scale(direction, rho), half_angle * (angle_weight * radial_weight) * half * rho,
+                            spread_weight(rho, reach, cone.scale)))
+    return samples + [(base, 0.0, 0.0)] * (len(QUAD_NODES) ** 2 - len(samples))
 
 
 def lobe_average(cone, form, centre, axis_u, axis_v, position, to_lobe):
     """The average of the spread weight over the region ``centre + axis_u x + axis_v y`` (a quad, [-1, 1]^2, or a
     disk), weighted by the rule's weight times a lobe's kernel max(m.z, 0) / |m|^4, m = ``to_lobe``(point -
-    position) (module docstring; ``to_lobe`` linear: the shading frame's coordinates, then the LTC's Minv); the
-    rules follow the lobe (``quad_points``, ``disk_points``).  Each point's m and its offset
-    from the foot are formed as vectors (expanding their squared lengths into dot products of the three vectors
-    cancels in float32 near the foot); the three vectors in the lobe's space are normalised by their size first
-    (the average does not depend on it; a light 1e-6 m or 1e6 m away stays finite in float32)."""
+    position) (module docstring; ``to_lobe`` linear: the shading frame's coordinates, then the LTC's Minv).  The
+    rules follow the lobe (``quad_points``, ``disk_points``); a disk light's broad lobes average over the light's
+    own overlap with the cone (``lens_samples``) where the cone carries the light's disk.  Each point's m and its
+    offset from the foot are formed as vectors (expanding their squared lengths into dot products of the three
+    vectors cancels in float32 near the foot); the three vectors in the lobe's space are normalised by their size
+    first (the average does not depend on it; a light 1e-6 m or 1e6 m away stays finite in float32)."""
     a, b, e = to_lobe(centre - position), to_lobe(axis_u), to_lobe(axis_v)
     inv_size = op.inverse_sqrt(op.dot(a, a) + op.dot(b, b) + op.dot(e, e), 1e-30)
     a, b, e = op.scale(a, inv_size), op.scale(b, inv_size), op.scale(e, inv_size)
-    points = quad_points(a, b, e) if form == "quad" else disk_points(a, b, e)
     g = centre - cone.foot
+
+    def on_region(x, y, w):
+        return a + op.scale(b, x) + op.scale(e, y), w, cone.weight(op.length(g + op.scale(axis_u, x) + op.scale(axis_v, y)))
+
+    if form == "quad":
+        samples = [on_region(*point) for point in quad_points(a, b, e)]
+    elif cone.disk is None:
+        samples = [on_region(*point) for point in disk_points(a, b, e)]
+    else:
+        narrow, warped = warped_disk_rule(a, b, e)
+        samples = [(op.vselect(narrow, m_warped, m_lens), op.select(narrow, w_warped, w_lens),
+                    op.select(narrow, c_warped, c_lens))
+                   for (m_warped, w_warped, c_warped), (m_lens, w_lens, c_lens)
+                   in zip([on_region(*point) for point in warped], lens_samples(cone, position, to_lobe, inv_size))]
     total, weighted = 0.0, 0.0
-    for x, y, w in points:
-        m = a + op.scale(b, x) + op.scale(e, y)
+    for m, w, spread_w in samples:
         m2 = op.maximum(op.dot(m, m), KERNEL_FLOOR)
         kernel = op.safe_div(op.maximum(op.component(m, 2), 0.0) * w, m2 * m2)
-        rho = op.length(g + op.scale(axis_u, x) + op.scale(axis_v, y))
         total = kernel + total
-        weighted = kernel * cone.weight(rho) + weighted
+        weighted = kernel * spread_w + weighted
     return op.safe_div(weighted, total)
 
 
@@ -343,4 +414,4 @@ def spread_disk(position, centre, axis_u, axis_v, spread):
                        op.vselect(light_in_circle, axis_u, op.scale(towards, length * fit)))
     new_v = op.vselect(circle_in_light, op.scale(unit_v, cone.radius),
                        op.vselect(light_in_circle, axis_v, op.scale(across, width * fit)))
-    return new_centre, new_u, new_v, cone, op.select(misses, 0.0, 1.0)
+    return new_centre, new_u, new_v, replace(cone, disk=(centre, axis_u, axis_v)), op.select(misses, 0.0, 1.0)

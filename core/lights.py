@@ -818,6 +818,15 @@ SPREAD_OUTPUTS = {
 }
 
 
+#: A disk light with spread also hands its lobes its own ellipse, over whose overlap with the cone broad lobes average
+#: the weight (``light_spread.lens_samples``; the region it shades is an ellipse fitted to that overlap).
+SPREAD_DISK_OUTPUTS = {
+    "Spread Disk Center": vector("The disk light's own centre (core/light_spread.py, lens_samples)", "XYZ"),
+    "Spread Disk Axis U": vector("The disk light's own first semi-axis", "XYZ"),
+    "Spread Disk Axis V": vector("The disk light's own second semi-axis", "XYZ"),
+}
+
+
 def spread_geometry(base, light, position, spread):
     """The outputs of a quad or disk light's data function (``light``) with Blender's spread applied
     (core/light_spread.py): the clamped region's geometry, the cone (``SPREAD_OUTPUTS``) and the radiance, 0 where
@@ -831,6 +840,7 @@ def spread_geometry(base, light, position, spread):
         centre, axis_u, axis_v, cone, hits = light_spread.spread_disk(position, light["Center"], light["Axis U"],
                                                                       light["Axis V"], spread)
         out = {"Center": centre, "Axis U": axis_u, "Axis V": axis_v}
+        out.update(zip(SPREAD_DISK_OUTPUTS, cone.disk))
     out["Radiance"] = op.scale(light["Radiance"], hits)
     out.update({"Spread Foot": cone.foot, "Spread Radius": cone.radius, "Spread Scale": cone.scale})
     return out
@@ -838,7 +848,8 @@ def spread_geometry(base, light, position, spread):
 
 def spread_cone_of(light):
     """The ``light_spread.SpreadCone`` in the outputs of a light with spread (``spread_geometry``)."""
-    return light_spread.SpreadCone(light["Spread Foot"], light["Spread Radius"], light["Spread Scale"])
+    disk = tuple(light[n] for n in SPREAD_DISK_OUTPUTS) if "Spread Disk Center" in light else None
+    return light_spread.SpreadCone(light["Spread Foot"], light["Spread Radius"], light["Spread Scale"], disk)
 
 
 def _with_options(base, options):
@@ -867,6 +878,8 @@ def _with_options(base, options):
     outputs = dict(data.output_sockets)
     if "spread" in options:
         outputs.update(SPREAD_OUTPUTS)
+        if base == "disk":
+            outputs.update(SPREAD_DISK_OUTPUTS)
     words = {"cone": "the talk's cone falloff at the projector apex", "range": "the talk's windowed range",
              "spread": "Blender's spread", "linking": "Blender's light linking"}
     return NodeFunction(f"{data.name} ({', '.join(options)})", body, inputs, outputs,

@@ -696,13 +696,14 @@ def _disk_spread_truth(position, radius, height, spread, density, radial=200, an
     return float(np.sum(_spread_weight(q, position, spread) * density(w) * w[:, 2] / r2 * area))
 
 
-@pytest.mark.parametrize("lobe, median_limit, p90_limit", [("lambert", 0.02, 0.10), ("ggx r 0.1", 0.03, 0.25)])
+@pytest.mark.parametrize("lobe, median_limit, p90_limit", [("lambert", 0.01, 0.05), ("ggx r 0.1", 0.03, 0.25)])
 def test_spread_on_a_disk(energy_tables, lobe, median_limit, p90_limit):
     """Issue 27: a disk light with spread 90 deg (radius 0.3-1 m at 0.6-2 m, 30 seeded receivers viewing near the
     mirror direction of a point of the light), its LTC integral times the spread's average under the lobe's kernel
-    against the dense integral of the same LTC times the weight.  Lambert: median <= 2%, p90 <= 10% (measured 1.4% /
-    8.3%: the lens of a disk and the cone's circle taken as a fitted ellipse); GGX r = 0.1: median <= 3%, p90 <= 25%
-    (measured 1.2% / 15% with the warped rule for narrow lobes; the polar rule alone, before: 13% / 53%)."""
+    against the dense integral of the same LTC times the weight.  Lambert: median <= 1%, p90 <= 5% (measured 0.36% /
+    2.7% with the polar rule about the foot over the disk's true overlap with the cone; averaged over the overlap's
+    fitted ellipse, before: 1.4% / 8.3%); GGX r = 0.1: median <= 3%, p90 <= 25% (measured 1.2% / 15% with the warped
+    rule for narrow lobes; the polar rule alone, before: 13% / 53%)."""
     from rt_lookdev.core.ltc import matrix, polygon, shading
 
     rng = np.random.default_rng(5)
