@@ -179,8 +179,9 @@ def warped_gauss(peak, footprint):
     the Gauss nodes s, with weights times the map's Jacobian A f cosh(A s + B); A, B make x(-1) = -1, x(1) = 1
     (A = (a1 - a0) / 2, B = (a1 + a0) / 2, a0,1 = asinh((-+1 - peak) / f)).  The points crowd within about f of the
     peak, like the lobe's kernel (1 / (1 + x^2 / f^2) after the map); for f much larger than 1 the map is linear and
-    the rule is Gauss-Legendre's.  (The sinh map of tanh-sinh / Kahan's substitution for peaked integrands, applied
-    per axis; this project's construction.)  Returns [(x, weight)]."""
+    the rule is Gauss-Legendre's.  This is the sinh transformation of Johnston & Elliott 2005 ("A sinh
+    transformation for evaluating nearly singular boundary element integrals", IJNME 62), applied per axis with the
+    lobe's peak and footprint as its centre and width (this project's use).  Returns [(x, weight)]."""
     a0 = _asinh(op.safe_div(-1.0 - peak, footprint))
     a1 = _asinh(op.safe_div(1.0 - peak, footprint))
     slope, shift = (a1 - a0) * 0.5, (a1 + a0) * 0.5
