@@ -38,8 +38,8 @@ near their reflection direction only (issue 27).
 Against the exact integral of a Lambert receiver (numpy, seeded random lights, receivers and spreads
 20-170 deg; 4 x 4 points then): quads 0.3-2.5 m at 0.5-3 m (280), median 0.06%, p90 1.7%, those in the cone's narrow part
 (R < half their size) 1.3% / 4.3%; disks of radius 0.3-1 m at 0.6-2 m (91), median 1.2%, p90 8.4%, max
-14%, the error in the partial overlaps, whose lens the fitted ellipse only approximates
-(tests/core/test_lights.py checks the quad's).  The GGX LTC over seeded quads against the dense integral of
+14%, the error in the partial overlaps, then averaged over the lens's fitted ellipse (now over the lens itself:
+below) (tests/core/test_lights.py checks the quad's).  The GGX LTC over seeded quads against the dense integral of
 the same LTC times w (tests/core/test_lights.py checks r = 0.4 at random spreads and r = 0.1 at 60 deg),
 median / p90 / max over 40 quads, spread 60 deg: with each lobe's kernel and the warped 5 x 5 rule, r = 0.1 0.33% /
 11% / 17%, r = 0.4 0.13% / 0.97% / 14%, r = 1 0.25% / 0.85% / 3.5%; the plain 5 x 5 rule (before): 5.7% / 53% / 132%,
@@ -69,13 +69,6 @@ MAX_HALF_SPREAD = 0.5 * math.pi
 #: the test set of tests/core/test_lights.py, median / p90 / max: 4 x 4 points 0.27% / 6.7% / 15%, 5 x 5 0.06% /
 #: 1.7% / 7.0%, 6 x 6 0.02% / 0.95% / 4.4%).
 QUAD_NODES, QUAD_WEIGHTS = (tuple(float(x) for x in a) for a in np.polynomial.legendre.leggauss(5))
-#: The disk's rule: Gauss-Legendre in the radius (3 points, weighted by r) x 6 equally spaced angles.
-_RADIAL_X, _RADIAL_W = np.polynomial.legendre.leggauss(3)
-DISK_RADII = tuple(float(0.5 * (x + 1.0)) for x in _RADIAL_X)
-DISK_RADIAL_WEIGHTS = tuple(float(0.25 * w * (x + 1.0)) for x, w in zip(_RADIAL_X, _RADIAL_W))
-DISK_ANGLES = tuple(2.0 * math.pi * (k + 0.5) / 6.0 for k in range(6))
-
-
 def half_spread(spread):
     """h = spread / 2 within [MIN_HALF_SPREAD, pi / 2]."""
     return op.clamp(spread * 0.5, MIN_HALF_SPREAD, MAX_HALF_SPREAD)
@@ -131,17 +124,6 @@ FULL_RADIUS = 1e15
 KERNEL_FLOOR = 1e-12
 
 
-def _disk_points():
-    """The polar rule (``DISK_RADII`` x ``DISK_ANGLES``), padded with points of weight 0 to the warped rule's count
-    (``disk_points`` picks, per point, this rule's or ``warped_disk_points``')."""
-    points = [(r * math.cos(a), r * math.sin(a), wr / len(DISK_ANGLES))
-              for r, wr in zip(DISK_RADII, DISK_RADIAL_WEIGHTS) for a in DISK_ANGLES]
-    return points + [(0.0, 0.0, 0.0)] * (len(QUAD_NODES) ** 2 - len(points))
-
-
-#: The disk's polar rule: points (x, y, weight) of ``centre + axis_u x + axis_v y`` over the unit disk.
-DISK_POINTS = _disk_points()
-
 #: The lobe's footprint on the quad's plane, as a fraction of the distance t along the lobe's axis to the plane,
 #: times 1 / |b| (b the quad's half-extent in the lobe's space): the kernel t / (t^2 + rho^2)^2 of a plane facing
 #: the axis falls to half at rho = 0.64 t.  Measured (GGX r = 0.1 / 0.4 / 1, spread 60 deg, median): 0.4: 0.59% /
@@ -192,23 +174,29 @@ def warped_gauss(peak, footprint):
     return rule
 
 
-def quad_points(a, b, e):
-    """The quad's rule, points (x, y, weight) of ``centre + axis_u x + axis_v y`` over [-1, 1]^2, for the lobe whose
-    space holds the quad as a + b x + e y: the warped Gauss rule of each axis (``warped_gauss``) about the point
-    where the lobe's axis meets the quad's plane, with the lobe's footprint there, FOOTPRINT t / |b| and t / |e|
-    (the plain 5 x 5 Gauss rule, nearly, where the lobe is broad or faces away from the plane)."""
+def lobe_footprint(a, b, e):
+    """(x*, y*, f_x, f_y, faces) of the lobe whose space holds the region as a + b x + e y: where its axis meets the
+    region's plane (``lobe_peak``; 0, 0 where the plane is behind the lobe: ``faces`` false) and its footprint
+    there along each axis, FOOTPRINT t / |b| and t / |e| within ``FOOTPRINT_BOUNDS`` (the upper bound where it does
+    not face the plane)."""
     x_peak, y_peak, t = lobe_peak(a, b, e)
     faces = op.greater(t, 0.0)
     lo, hi = FOOTPRINT_BOUNDS
 
-    def footprint(extent):
+    def along(extent):
         return op.select(faces, op.clamp(op.safe_div(FOOTPRINT * t, op.length(extent)), lo, hi), hi)
 
-    def peak(x):
-        return op.select(faces, op.clamp(x, -PEAK_LIMIT, PEAK_LIMIT), 0.0)
+    return op.select(faces, x_peak, 0.0), op.select(faces, y_peak, 0.0), along(b), along(e), faces
 
-    xs = warped_gauss(peak(x_peak), footprint(b))
-    ys = warped_gauss(peak(y_peak), footprint(e))
+
+def quad_points(a, b, e):
+    """The quad's rule, points (x, y, weight) of ``centre + axis_u x + axis_v y`` over [-1, 1]^2, for the lobe whose
+    space holds the quad as a + b x + e y: the warped Gauss rule of each axis (``warped_gauss``) about the point
+    where the lobe's axis meets the quad's plane, with the lobe's footprint there (``lobe_footprint``; the plain
+    5 x 5 Gauss rule, nearly, where the lobe is broad or faces away from the plane)."""
+    x_peak, y_peak, footprint_x, footprint_y, _ = lobe_footprint(a, b, e)
+    xs = warped_gauss(op.clamp(x_peak, -PEAK_LIMIT, PEAK_LIMIT), footprint_x)
+    ys = warped_gauss(op.clamp(y_peak, -PEAK_LIMIT, PEAK_LIMIT), footprint_y)
     return [(x, y, wx * wy) for x, wx in xs for y, wy in ys]
 
 
@@ -225,9 +213,9 @@ def _square_from_disk(x, y):
 #: How far inside the disk's rim (radius 1) the lobe's peak is pulled for the warped disk rule.
 DISK_PEAK_LIMIT = 0.999
 #: A lobe whose footprint (``quad_points``) is below this many of the disk's semi-axes along either axis takes the
-#: warped rule, a broader one the polar rule about the cone's foot (``lens_samples``; ``DISK_POINTS`` where the cone
-#: does not carry the light's disk): exact along each ray for the cone, where the warped rule for every lobe put a
-#: Lambert receiver 3% off, the cone's apex between its points (tests/blender/test_light_model.py, spread 40 deg).
+#: warped rule, a broader one the polar rule about the cone's foot (``lens_samples``): exact along each ray for the
+#: cone, where the warped rule for every lobe put a Lambert receiver 3% off, the cone's apex between its points
+#: (tests/blender/test_light_model.py, spread 40 deg).
 #: Validation suite, spread_disk GGX r = 0.4, median: 0.5 4.5%, 1.0 8.7%.
 NARROW_FOOTPRINT = 0.5
 
@@ -249,22 +237,9 @@ def warped_disk_points(x_peak, y_peak, footprint_x, footprint_y):
 def warped_disk_rule(a, b, e):
     """(narrow, points): whether the lobe whose space holds the disk as a + b x + e y is narrow (``NARROW_FOOTPRINT``)
     and faces the disk's plane, and the warped rule's points for it (``warped_disk_points``)."""
-    x_peak, y_peak, t = lobe_peak(a, b, e)
-    faces = op.greater(t, 0.0)
-    lo, hi = FOOTPRINT_BOUNDS
-    footprint_x = op.select(faces, op.clamp(op.safe_div(FOOTPRINT * t, op.length(b)), lo, hi), hi)
-    footprint_y = op.select(faces, op.clamp(op.safe_div(FOOTPRINT * t, op.length(e)), lo, hi), hi)
+    x_peak, y_peak, footprint_x, footprint_y, faces = lobe_footprint(a, b, e)
     narrow = op.logical_and(faces, op.less(op.minimum(footprint_x, footprint_y), NARROW_FOOTPRINT))
-    return narrow, warped_disk_points(op.select(faces, x_peak, 0.0), op.select(faces, y_peak, 0.0), footprint_x,
-                                      footprint_y)
-
-
-def disk_points(a, b, e):
-    """The disk's rule on the region itself: per point, the warped rule's where the lobe is narrow
-    (``warped_disk_rule``), else the polar rule's (``DISK_POINTS``)."""
-    narrow, warped = warped_disk_rule(a, b, e)
-    return [(op.select(narrow, xw, xp), op.select(narrow, yw, yp), op.select(narrow, ww, wp))
-            for (xw, yw, ww), (xp, yp, wp) in zip(warped, DISK_POINTS)]
+    return narrow, warped_disk_points(x_peak, y_peak, footprint_x, footprint_y)
 
 
 #: The lens rule's Gauss-Legendre points: angles about the foot, and along each ray (``lens_samples``).
@@ -279,7 +254,7 @@ def lens_samples(cone, position, to_lobe, inv_size):
     is linear along each ray, so this rule finds a disk's overlap with the cone, a lens, exactly where the region
     shaded is only its fitted ellipse (``spread_disk``).  m in the lobe's space scaled by ``inv_size`` (as
     ``lobe_average``'s); lengths in units of the disk's larger semi-axis; padded with points of weight 0 to the
-    warped rule's count."""
+    warped rule's count (``lobe_average`` picks one rule's point or the other's per point)."""
     centre, axis_u, axis_v = cone.disk
     length_u, length_v = op.length(axis_u), op.length(axis_v)
     size = op.maximum(length_u, length_v)
@@ -318,8 +293,8 @@ def lobe_average(cone, form, centre, axis_u, axis_v, position, to_lobe):
     """The average of the spread weight over the region ``centre + axis_u x + axis_v y`` (a quad, [-1, 1]^2, or a
     disk), weighted by the rule's weight times a lobe's kernel max(m.z, 0) / |m|^4, m = ``to_lobe``(point -
     position) (module docstring; ``to_lobe`` linear: the shading frame's coordinates, then the LTC's Minv).  The
-    rules follow the lobe (``quad_points``, ``disk_points``); a disk light's broad lobes average over the light's
-    own overlap with the cone (``lens_samples``) where the cone carries the light's disk.  Each point's m and its
+    quad's rule follows the lobe (``quad_points``); on a disk, a narrow lobe takes the warped rule
+    (``warped_disk_rule``), a broad one averages over the light's own overlap with the cone (``lens_samples``).  Each point's m and its
     offset from the foot are formed as vectors (expanding their squared lengths into dot products of the three
     vectors cancels in float32 near the foot); the three vectors in the lobe's space are normalised by their size
     first (the average does not depend on it; a light 1e-6 m or 1e6 m away stays finite in float32)."""
@@ -334,7 +309,7 @@ def lobe_average(cone, form, centre, axis_u, axis_v, position, to_lobe):
     if form == "quad":
         samples = [on_region(*point) for point in quad_points(a, b, e)]
     elif cone.disk is None:
-        samples = [on_region(*point) for point in disk_points(a, b, e)]
+        raise ValueError("a disk light's spread cone must carry the light's own disk (light_spread.spread_disk)")
     else:
         narrow, warped = warped_disk_rule(a, b, e)
         samples = [(op.vselect(narrow, m_warped, m_lens), op.select(narrow, w_warped, w_lens),
