@@ -126,7 +126,30 @@ _rtl_activate() {
     hash -r 2>/dev/null || true
 }
 
-if ! _rtl_env_setup; then
+# engines/three's pinned node packages (three.js and playwright-core, package-lock.json) for the browser tests:
+# installed with `npm ci` when node is here and the lock changed.  Without node the browser tests say so (and fail
+# under CI=true); nothing else needs it.
+_rtl_node_setup() {
+    local repo pkg stamp want
+    repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+    pkg="$repo/engines/three"
+    [[ -f "$pkg/package-lock.json" ]] || return 0
+    if ! command -v npm >/dev/null; then
+        echo "env.sh: npm not found: the three.js browser tests will be skipped (Debian: apt-get install nodejs npm)" >&2
+        return 0
+    fi
+    stamp="$pkg/node_modules/.rtl-lock-sha256"
+    want="$(cat "$pkg/package-lock.json" | sha256sum | cut -d' ' -f1)"
+    [[ -f "$stamp" && "$(cat "$stamp")" == "$want" ]] && return 0
+    echo "env.sh: installing engines/three's node packages (npm ci)"
+    if ! (cd "$pkg" && npm ci --no-audit --no-fund --loglevel=error); then
+        echo "env.sh: npm ci in $pkg failed (see above)" >&2
+        return 2
+    fi
+    echo "$want" >"$stamp"
+}
+
+if ! _rtl_env_setup || ! _rtl_node_setup; then
     # `return` works when this file is sourced; `exit` when it is run directly.
     return 2 2>/dev/null || exit 2
 fi

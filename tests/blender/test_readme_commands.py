@@ -32,6 +32,7 @@ RUN_BY = {
     "scripts/bake_luts.py": "tests/core/test_luts.py",
     "scripts/bake_environment.py": "tests/core/test_environment.py::test_readme_bake_environment_commands",
     "scripts/benchmark_light_sync.py": "tests/blender/test_bad_input.py::test_light_sync_benchmark_writes_its_report",
+    "scripts/benchmark_three_ltc.py": "tests/browser/test_three_tables.py::test_the_benchmark_script_writes_its_report",
     "scripts/robustness_sweep.py": MAIN_JOB,
     "scripts/validate_energy.py": MAIN_JOB,
     "scripts/build_demo_scene.py": MAIN_JOB,

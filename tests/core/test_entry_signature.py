@@ -34,6 +34,7 @@ CONVERTED = {
     "benchmarks/floor_shadows_benchmark": "benchmark_floor_shadows.py",
     "benchmarks/concave_shadows_benchmark": "benchmark_concave_shadows.py",
     "benchmarks/eevee_shadows_benchmark": "benchmark_eevee_shadows.py",
+    "benchmarks/three_ltc_benchmark": "benchmark_three_ltc.py",
 }
 
 
