@@ -33,6 +33,7 @@ RUN_BY = {
     "scripts/bake_environment.py": "tests/core/test_environment.py::test_readme_bake_environment_commands",
     "scripts/benchmark_light_sync.py": "tests/blender/test_bad_input.py::test_light_sync_benchmark_writes_its_report",
     "scripts/benchmark_three_ltc.py": "tests/browser/test_three_tables.py::test_the_benchmark_script_writes_its_report",
+    "scripts/build_three_area.py": "tests/core/test_three_area.py::test_the_committed_module_is_what_the_ir_gives",
     "scripts/robustness_sweep.py": MAIN_JOB,
     "scripts/validate_energy.py": MAIN_JOB,
     "scripts/build_demo_scene.py": MAIN_JOB,

@@ -16,6 +16,8 @@ with ``installRtLookdev`` (same texture settings, so that only the numbers diffe
   ``loadRtLookdevTables`` (three's ``EXRLoader``);
 - ``three_stock``: three as shipped (``RectAreaLightUniformsLib.init()``, whose tables minify with nearest filtering).
 three's horizon handling (the clipped-sphere form factor) is the same for every pair: what differs is the tables.
+- ``rtl_patched``: the material patched by ``patchAreaLights`` (``engines/three/src/patch.js``; single scattering, so
+  that it is the same BRDF as the truth): RT Lit's GGX LTC with its band and exact horizon clipping.
 Configurations (seeded): a camera 3-5 m from a point of the plane at 20-75 deg elevation (a 20 deg field of view, so
 every pixel sees the plane), a light of sides 0.5-3 m 0.8-2.5 m away, aimed at the point, its centre within 25 deg of
 the camera's mirror direction for three in four configurations (so that narrow lobes see it) and anywhere above 5 deg
@@ -25,7 +27,6 @@ elevation otherwise.  Error: relative, on the pixels whose truth carries > 10% o
 from __future__ import annotations
 
 import argparse
-import json
 import tempfile
 import time
 from dataclasses import dataclass
@@ -42,6 +43,9 @@ from . import ltc_random_lights
 REPO = Path(__file__).resolve().parents[2]
 ROUGHNESS = (0.1, 0.25, 0.4, 0.6, 0.8, 1.0)
 TABLES = ("three", "rtl_f32", "rtl_f16", "three_half", "three_stock")
+#: The patched material (engines/three/src/patch.js, single scattering so that it is the same BRDF): RT Lit's GGX
+#: LTC with its band and exact horizon clipping, with three's own tables installed for everything else.
+PATCHED = "rtl_patched"
 OURS = {"rtl_f32": "three", "rtl_f16": "three_half"}
 SEED = 3232
 #: quadrature panels tried in turn for the truth; a pixel whose estimate has not converged to REFERENCE_TOLERANCE
@@ -85,11 +89,6 @@ def configurations(count, seed=SEED):
     return out
 
 
-def export_tables(folder):
-    """The ``ltc_code`` layout's EXRs (f32 and f16) of the shipped tables, into ``folder``."""
-    return luts.export(folder, formats=("exr",), precisions=("f32", "f16"), layout="ltc_code")
-
-
 def truths(config, roughness, progress=entry.quiet):
     """Per pixel of one configuration: truth (n_r, n; NaN where the quadrature did not converge to
     REFERENCE_TOLERANCE), albedo (n_r, n) and view angle (n,)."""
@@ -127,24 +126,36 @@ def measure(n_configs, size, roughness=ROUGHNESS, tables=TABLES, seed=SEED, prog
     ``--scheduler`` / ``--workers`` options of ``distribute``; None: here); returns (browser run, rows) with
     rows[r] = {"truth", "albedo", "theta", table: estimates} pooled over the configurations."""
     spec = {"size": size, "roughness": list(roughness), "tables": list(tables),
-            "configs": configurations(n_configs, seed), "loadTables": ["f32", "f16"]}
+            "configs": configurations(n_configs, seed), "loadTables": ["f32", "f16"],
+            "patched": [{"name": f"{PATCHED}_{i}", "params": three_browser.PATCH_VARIANTS["specular"](r, r),
+                         "patch": {"specular": "single", "diffuse": "lambert", "sheen": "none"}}
+                        for i, r in enumerate(roughness)]}
     with tempfile.TemporaryDirectory(prefix="rtl-three-tables-") as tmp:
-        export_tables(Path(tmp) / "ltc_code")
-        run = three_browser.render(spec, Path(tmp) / "ltc_code")
+        run = three_browser.render(spec, three_browser.export_tables(tmp))
     progress(f"[three ltc] rendered {n_configs} configurations x {len(roughness)} roughness x {len(tables)} table "
              f"pairs at {size} x {size} in {run.info['seconds']:.1f} s ({run.info['renderer']})")
-    rows = {r: {"truth": [], "albedo": [], "theta": [], **{t: [] for t in tables}} for r in roughness}
     tasks = [TruthTask(c.positions, c.camera, c.corners, tuple(roughness)) for c in run.configs]
     records = distribute.map_tasks(f"{__name__}:run_task", tasks, where or argparse.Namespace(workers=0),
-                                   progress=progress, label=lambda t: f"truth of a configuration ({len(t.positions)} pixels)")
-    for k, (config, (truth, albedo, theta)) in enumerate(zip(run.configs, records)):
+                                   progress=progress, label=lambda t: f"truth at {len(t.positions)} pixels")
+    return run, collect_rows(run.configs, records, roughness, tables)
+
+
+def collect_rows(configs, truths_per_config, roughness, tables):
+    """rows[r] = {"truth", "albedo", "theta", table: estimates (and ``PATCHED``'s where rendered)} pooled over the
+    configurations, from their read-backs and their ``truths``."""
+    patched = all(f"{PATCHED}_{i}" in c.patched for c in configs for i in range(len(roughness)))
+    names = (*tables, PATCHED) if patched else tuple(tables)
+    rows = {r: {"truth": [], "albedo": [], "theta": [], **{t: [] for t in names}} for r in roughness}
+    for config, (truth, albedo, theta) in zip(configs, truths_per_config):
         for i, r in enumerate(roughness):
             rows[r]["truth"] += list(truth[i])
             rows[r]["albedo"] += list(albedo[i])
             rows[r]["theta"] += list(theta)
             for t in tables:
                 rows[r][t] += list(config.values[t][i])
-    return run, rows
+            if patched:
+                rows[r][PATCHED] += list(config.patched[f"{PATCHED}_{i}"])
+    return rows
 
 
 def summarise(rows, tables):
@@ -211,16 +222,14 @@ def run(args, progress=entry.flush_log):
     """Measure; writes ``args.out`` (Markdown) and the JSON beside it; returns the result."""
     t0 = time.perf_counter()
     browser, rows = measure(args.configs, args.size, seed=args.seed, progress=progress, where=args)
-    stats = summarise(rows, TABLES)
+    stats = summarise(rows, (*TABLES, PATCHED))
     result = {"date": time.strftime("%Y-%m-%d"), "configs": args.configs, "size": args.size, "seed": args.seed,
               "roughness": list(ROUGHNESS), "browser": browser.info, "stats": stats,
               "acceptance": acceptance(stats), "loaded_table_max_difference": table_orientation(browser),
               "truth_ran": distribute.where(args),
               "seconds": time.perf_counter() - t0}
     out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.with_suffix(".json").write_text(json.dumps(result, indent=1, default=outputs.json_default))
-    out.write_text(to_markdown(result))
+    outputs.write_results(out.parent, out.stem, result, to_markdown(result))
     progress(f"wrote {out} and {out.with_suffix('.json')}")
     return result
 
@@ -232,7 +241,7 @@ def _median_p90(stats):
 def to_markdown(result):
     """The result as Markdown (three_ltc.md)."""
     s = result["stats"]
-    names = [n for n in TABLES if n in s]
+    names = [n for n in (*TABLES, PATCHED) if n in s]
     b = result["browser"]
     lines = ["# The exported ltc_code tables in three.js, in a real browser", "",
              f"Measured {result['date']} with `python scripts/benchmark_three_ltc.py --configs {result['configs']} "
@@ -251,6 +260,10 @@ def to_markdown(result):
     lines.append("| pooled | " + str(s[names[0]]["pooled"]["lights_over_10pct"]) + " | "
                  + str(sum(s["unconverged"].values())) + " | " + " | ".join(
         _median_p90(s[n]["pooled"]) for n in names) + " |")
+    if PATCHED in s:
+        lines += ["", f"`{PATCHED}`: the white metal patched by `patchAreaLights` (single scattering): RT Lit's GGX "
+                  "LTC with its band and exact horizon clipping in place of three's LTC and clipped-sphere form "
+                  "factor; the other columns differ only in their tables."]
     lines += ["", "Acceptance (issue 32: the exported pair's median at or below three's own at every roughness, and a "
               "lower pooled p90):", ""]
     for ours, a in result["acceptance"].items():

@@ -42,11 +42,12 @@ def missing():
 @dataclass
 class ConfigResult:
     """One configuration's read-back: world positions (n, 3), the camera position (3,), the light's corners (4, 3)
-    in three's order, and per table pair the rendered value (n_roughness, n)."""
+    in three's order, per table pair the rendered value (n_roughness, n), and per patched variant its value (n,)."""
     positions: np.ndarray
     camera: np.ndarray
     corners: np.ndarray
     values: dict
+    patched: dict
 
 
 @dataclass
@@ -66,8 +67,10 @@ def _floats(b64):
 def render(spec, data_dir=None, timeout=600):
     """Run ``spec`` (harness.js' ``rtlRender`` fields, and ``loadTables``) in the browser; returns a ``Run``.
 
-    ``data_dir``: an export of the ``ltc_code`` layout with EXRs (served at /data/), needed by the ``rtl_*`` pairs.
+    ``data_dir`` (served at /data/): ``export_tables``' folder, the ``ltc_code`` layout's EXRs in ``ltc_code/`` (the
+    ``rtl_*`` pairs) and the ``rtl`` layout's f32 EXRs in ``rtl/`` (the patched variants).
     """
+    spec = dict(spec, dataUrl=spec.get("dataUrl", "/data/ltc_code/"), rtlUrl=spec.get("rtlUrl", "/data/rtl/"))
     reason = missing()
     if reason:
         raise RuntimeError(f"three.js browser run impossible: {reason}")
@@ -88,14 +91,26 @@ def render(spec, data_dir=None, timeout=600):
     for item in raw["results"]:
         positions = np.stack([_floats(item[k]) for k in ("x", "y", "z")], axis=-1)
         values = {name: np.stack([_floats(b) for b in per_r]) for name, per_r in item["values"].items()}
+        patched = {name: _floats(b) for name, b in item.get("patched", {}).items()}
         configs.append(ConfigResult(positions, np.asarray(item["camera"], np.float64),
-                                    np.asarray(item["corners"], np.float64), values))
+                                    np.asarray(item["corners"], np.float64), values, patched))
     info = dict(raw["info"], seconds=raw["seconds"])
     tables = {precision: {key: np.frombuffer(base64.b64decode(t["data"]), dtype="<f4" if t["type"] == "float32"
                                              else "<f2").astype(np.float64).reshape(64, 64, 4)
                           for key, t in pair.items()}
               for precision, pair in raw.get("tables", {}).items()}
     return Run(info, configs, tables)
+
+
+def export_tables(folder):
+    """What the page reads, into ``folder``: the shipped tables in the ``ltc_code`` layout (EXR, f32 and f16) in
+    ``ltc_code/`` and in the ``rtl`` layout (EXR, f32) in ``rtl/``."""
+    from ...core.export import luts
+
+    folder = Path(folder)
+    luts.export(folder / "ltc_code", formats=("exr",), precisions=("f32", "f16"), layout="ltc_code")
+    luts.export(folder / "rtl", formats=("exr",), precisions=("f32",), layout="rtl")
+    return folder
 
 
 def pixel_frames(positions, camera, corners, normal=(0.0, 0.0, 1.0)):
@@ -154,3 +169,46 @@ def three_rect_area_specular(ltc1, ltc2, roughness, v_local, corners_local):
     length = np.linalg.norm(f, axis=-1)
     form_factor = np.maximum((length * length + f[:, 2]) / (length + 1.0), 0.0)
     return magnitude * form_factor
+
+
+# --- the patched material (engines/three/src/patch.js), in numpy -----------------------------------------------------
+#: The variants the tests and benchmarks render with the patch: MeshPhysicalMaterial parameters that isolate one lobe
+#: (F0 = F90 = 1 for the specular; no specular for the diffuse and the sheen; a black base under the sheen).
+PATCH_VARIANTS = {
+    "specular": lambda r, s: {"color": 0xFFFFFF, "metalness": 1.0, "roughness": r},
+    "diffuse": lambda r, s: {"color": 0xFFFFFF, "metalness": 0.0, "roughness": r, "specularIntensity": 0.0},
+    "sheen": lambda r, s: {"color": 0x000000, "metalness": 0.0, "roughness": r, "specularIntensity": 0.0,
+                           "sheen": 1.0, "sheenColor": 0xFFFFFF, "sheenRoughness": s},
+}
+
+
+def patched_reference(tables, config, lobe, roughness, sheen_roughness=0.5, specular="turquin"):
+    """What the patch computes for ``PATCH_VARIANTS[lobe]`` at each pixel of ``config``, from the same node functions
+    evaluated by the numpy backend (core/export/three_area.py's list) with ``tables`` (a ``LutSet``): the
+    specular (F0 = F90 = 1) Scale + Bias, times Turquin's compensation when ``specular`` is "turquin"; the CoD
+    diffuse; the Zeltner sheen."""
+    from ...core import multiscatter
+    from ...core.materials import lobes
+
+    n = len(config.positions)
+    position = config.positions
+    view = config.camera - position
+    view /= np.linalg.norm(view, axis=-1, keepdims=True)
+    corners = config.corners[::-1]                       # RT Lit's winding (patch.js reverses three's order too)
+    geometry = {"Position": position, "N": np.tile([0.0, 0.0, 1.0], (n, 1)), "V": view,
+                **{f"p{k}": np.tile(corners[k], (n, 1)) for k in range(4)},
+                "Center": np.tile(config.corners.mean(axis=0), (n, 1))}
+    if lobe == "specular":
+        out = lobes.GGX.function("quad", exact_horizon=True)(tables, **geometry, Roughness=np.full(n, roughness))
+        value = np.asarray(out["Scale"]) + np.asarray(out["Bias"])
+        if specular == "turquin":
+            scale = multiscatter.TURQUIN_COMPENSATION(F0=np.ones((n, 3)), E=np.asarray(out["E"]))["Scale"]
+            value = value * np.asarray(scale)[..., 0]
+        return value
+    if lobe == "diffuse":
+        return np.asarray(lobes.COD.function("quad", exact_horizon=True)(
+            tables, **geometry, Roughness=np.full(n, roughness))["Diffuse"])
+    if lobe == "sheen":
+        return np.asarray(lobes.ZELTNER.function("quad", exact_horizon=True)(
+            tables, **geometry, **{"Sheen Roughness": np.full(n, sheen_roughness)})["Sheen"])
+    raise ValueError(f"unknown lobe {lobe!r}; choose from {', '.join(PATCH_VARIANTS)}")

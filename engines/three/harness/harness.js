@@ -5,7 +5,7 @@ import * as THREE from 'three';
 import { RectAreaLightTexturesLib } from 'three/addons/lights/RectAreaLightTexturesLib.js';
 import { RectAreaLightUniformsLib } from 'three/addons/lights/RectAreaLightUniformsLib.js';
 import { EXRLoader } from 'three/addons/loaders/EXRLoader.js';
-import { installRtLookdev, loadRtLookdevTables, ltcTexture } from 'rt-lookdev-three';
+import { installRtLookdev, loadRtLitTables, loadRtLookdevTables, ltcTexture, patchAreaLights } from 'rt-lookdev-three';
 
 const PLANE_SIDE = 200;
 
@@ -94,9 +94,11 @@ function channel( pixels, c ) {
 }
 
 // spec: { size, roughness: [...], tables: [...], dataUrl, configs: [{ camera: {position, target, fov}, light:
-// {position, target, width, height, up?} }] }.  Returns per config the world positions (x, y, z planes), the camera
-// position, the light's corners and, per table pair, the red channel of the render at each roughness (base64
-// float32, in the order of spec.roughness).
+// {position, target, width, height, up?} }], patched?: [{ name, params, patch }], rtlUrl? }.  Returns per config the
+// world positions (x, y, z planes), the camera position, the light's corners and, per table pair, the red channel
+// of the render at each roughness (base64 float32, in the order of spec.roughness); with `patched`, per variant the
+// red channel of a MeshPhysicalMaterial(params), patched by patchAreaLights(material, patch) unless patch is null
+// (three's own tables are installed for these: RectAreaLightUniformsLib.init()).
 async function render( spec ) {
 
 	const size = spec.size;
@@ -114,6 +116,7 @@ async function render( spec ) {
 	const target = new THREE.WebGLRenderTarget( size, size, { type: THREE.FloatType, format: THREE.RGBAFormat,
 		minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter, depthBuffer: true } );
 	const pairs = await tablePairs( spec.tables, spec.dataUrl );
+	const rtlTables = spec.patched ? await loadRtLitTables( spec.rtlUrl, { EXRLoader } ) : null;
 	const plane = new THREE.PlaneGeometry( PLANE_SIDE, PLANE_SIDE );
 	const results = [];
 	for ( const config of spec.configs ) {
@@ -144,6 +147,19 @@ async function render( spec ) {
 				mesh.material.dispose();
 
 			}
+
+		}
+
+		out.patched = {};
+		RectAreaLightUniformsLib.init();
+		for ( const variant of spec.patched || [] ) {
+
+			const material = new THREE.MeshPhysicalMaterial( variant.params );
+			if ( variant.patch ) patchAreaLights( material, { tables: rtlTables, ...variant.patch } );
+			mesh.material = material;
+			renderer.render( scene, camera );
+			out.patched[ variant.name ] = toBase64( channel( readTarget( renderer, target, size ), 0 ) );
+			material.dispose();
 
 		}
 

@@ -146,3 +146,5 @@ export async function loadRtLookdevTables( baseUrl, { precision = 'f32', EXRLoad
 	return out;
 
 }
+
+export { patchAreaLights, loadRtLitTables, RTL_AREA_TABLES } from './patch.js';

@@ -50,3 +50,32 @@ test( 'loadRtLookdevTables checks its options before fetching', async () => {
 	await assert.rejects( loadRtLookdevTables( 'x/', { precision: 'f32' } ), /EXRLoader/ );
 
 } );
+
+test( 'patchAreaLights checks the material, the options and the tables', async () => {
+
+	const { MeshPhysicalMaterial, MeshBasicMaterial } = await import( 'three' );
+	const { patchAreaLights, RTL_AREA_TABLES } = await import( '../src/index.js' );
+	const tables = Object.fromEntries( Object.keys( RTL_AREA_TABLES ).map( ( name ) => [ name, {} ] ) );
+	assert.throws( () => patchAreaLights( new MeshBasicMaterial(), { tables } ), /MeshStandardMaterial/ );
+	assert.throws( () => patchAreaLights( new MeshPhysicalMaterial(), { tables, specular: 'kulla' } ), /specular must be one of turquin, single/ );
+	assert.throws( () => patchAreaLights( new MeshPhysicalMaterial(), { tables: {} } ), /needs the tables ltc_/ );
+	const material = patchAreaLights( new MeshPhysicalMaterial(), { tables, diffuse: 'lambert' } );
+	assert.deepEqual( material.userData.rtLookdevArea, { specular: 'turquin', diffuse: 'lambert', sheen: 'zeltner' } );
+	assert.match( material.customProgramCacheKey(), /rt-lookdev-area:turquin:lambert:zeltner/ );
+
+} );
+
+test( 'the patch puts its lobes in the fragment shader and binds every table', async () => {
+
+	const { MeshPhysicalMaterial } = await import( 'three' );
+	const { patchAreaLights, RTL_AREA_TABLES } = await import( '../src/index.js' );
+	const tables = Object.fromEntries( Object.keys( RTL_AREA_TABLES ).map( ( name ) => [ name, { name } ] ) );
+	const material = patchAreaLights( new MeshPhysicalMaterial(), { tables } );
+	const shader = { uniforms: {}, fragmentShader: 'a\n#include <lights_physical_pars_fragment>\nb' };
+	material.onBeforeCompile( shader, null );
+	for ( const [ name, table ] of Object.entries( RTL_AREA_TABLES ) ) assert.equal( shader.uniforms[ table.uniform ].value.name, name );
+	assert.match( shader.fragmentShader, /#define RE_Direct_RectArea RE_Direct_RectArea_RtLit/ );
+	assert.match( shader.fragmentShader, /rtl_quad_ggx\(/ );
+	assert.match( shader.fragmentShader, /rtl_turquin_compensation\(/ );
+
+} );

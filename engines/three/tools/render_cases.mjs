@@ -3,8 +3,9 @@
 //   node tools/render_cases.mjs --spec SPEC.json --data EXPORT_DIR --out RESULT.json
 //
 // SPEC is what harness/harness.js' `rtlRender` takes (its comment says the fields), plus `loadTables` (a list of
-// precisions whose pair is also returned as loadRtLookdevTables reads it); EXPORT_DIR is an export of the
-// `ltc_code` layout (python scripts/export_luts.py --layout ltc_code --formats exr), served at /data/.  Used by the
+// precisions whose pair is also returned as loadRtLookdevTables reads it); EXPORT_DIR, served at /data/, holds the
+// `ltc_code` layout's EXRs in ltc_code/ and the `rtl` layout's f32 EXRs in rtl/ (python scripts/export_luts.py
+// --layout ... --formats exr; validation/harness/three_browser.export_tables writes both).  Used by the
 // Python side of the project's tests and benchmarks (validation/harness/three_browser.py).
 import { readFileSync, writeFileSync } from 'node:fs';
 import { parseArgs } from 'node:util';
@@ -19,7 +20,8 @@ if ( ! args.spec || ! args.out ) {
 }
 
 const spec = JSON.parse( readFileSync( args.spec, 'utf8' ) );
-spec.dataUrl = spec.dataUrl || '/data/';
+spec.dataUrl = spec.dataUrl || '/data/ltc_code/';
+spec.rtlUrl = spec.rtlUrl || '/data/rtl/';
 const t0 = performance.now();
 const session = await openPage( '/harness/index.html', { dataDir: args.data } );
 try {
