@@ -99,14 +99,18 @@ class Camera:
         horizontal = self.sensor_fit == "HORIZONTAL" or (self.sensor_fit == "AUTO" and w >= h)
         return (extent, extent * h / w) if horizontal else (extent * w / h, extent)
 
-    def view_projection(self):
-        """The OpenGL clip-from-world matrix (4 x 4, float64) of this camera: Blender's view frame mapped to
-        NDC [-1, 1]^2, depth [clip_start, clip_end] to [-1, 1]."""
+    def view(self):
+        """The view matrix (4 x 4, float64): world to Blender's camera frame (looking along -Z, +Y up)."""
         m = np.asarray(self.matrix_world, np.float64)
         rot = m[:3, :3] / np.linalg.norm(m[:3, :3], axis=0)          # no scale in the view
         view = np.eye(4)
         view[:3, :3] = rot.T
         view[:3, 3] = -rot.T @ m[:3, 3]
+        return view
+
+    def projection(self):
+        """The OpenGL projection (4 x 4, float64): Blender's view frame mapped to NDC [-1, 1]^2, depth
+        [clip_start, clip_end] to [-1, 1]."""
         hw, hh = self.frame()
         side = max(hw, hh)
         sx, sy = (2.0 * side * float(s) for s in self.shift)           # shift: units of the larger side
@@ -122,7 +126,11 @@ class Camera:
             proj[0, 2], proj[1, 2] = sx / hw, sy / hh
             proj[2, 2], proj[2, 3] = -(f + n) / (f - n), -2.0 * f * n / (f - n)
             proj[3, 2] = -1.0
-        return proj @ view
+        return proj
+
+    def view_projection(self):
+        """The OpenGL clip-from-world matrix (4 x 4, float64) of this camera: ``projection() @ view()``."""
+        return self.projection() @ self.view()
 
 
 @dataclass

@@ -52,6 +52,41 @@ def test_exported_scene_draws_like_cycles(empty_scene, gl_available, lut_dir, tm
     assert covered.sum() <= 0.005 * (cycles.max(-1) > 0).sum()
 
 
+def test_the_web_viewer_draws_the_exported_scene_like_cycles(empty_scene, lut_dir, tmp_path):
+    """Issue 32, item 3: the scene above, exported as a web bundle (core/export/web_scene.py) and drawn by the viewer
+    (engines/viewer, plain WebGL2) in headless Chromium on SwiftShader, against Cycles' render of its RT Lit node
+    groups: median <= 1e-3, p99 <= 1e-2 relative (the issue's targets; GLSL ES has no `precise`, so the driver may
+    fuse and reorder what the GLSL 4.50 renderer above keeps in numpy's order)."""
+    import os
+
+    from rt_lookdev.addon import scene_export
+    from rt_lookdev.core.export import web_scene
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+    from rt_lookdev.validation.harness import three_browser
+    from rt_lookdev.validation.harness.engines import compare, render_cycles_passes
+
+    why = three_browser.missing()
+    if why:
+        if os.environ.get("CI", "").lower() == "true":
+            pytest.fail(f"{why} (CI installs it: .ci/run, scripts/env.sh)")
+        pytest.skip(why)
+    scene = rt_lit_scene.build([("all", Features("kulla_conty", "wrapped", sheen=True, cloth=True)),
+                                ("typical", Features("turquin", "cod"))], resolution=64, hdri="forest", lut_dir=lut_dir)
+    size = (scene.render.resolution_x, scene.render.resolution_y)
+    cycles = render_cycles_passes(scene, size)["Combined"]
+    desc = scene_export.export_scene(scene, tmp_path / "export", lut_dir)
+    draw = web_scene.write_web(tmp_path / "web", desc)
+    assert len(draw["programs"]) == 2 and [o["name"] for o in draw["objects"]] == [o.name for o in desc.objects]
+    image, info = three_browser.render_viewer(tmp_path / "web")
+    stats = compare(cycles, image, positive_floor=1e-3)
+    covered = (cycles.max(-1) > 0) != (image.max(-1) > 0)
+    print(f"viewer ({info['renderer']}) vs Cycles: median {stats['median']:.2e}, p99 {stats['p99']:.2e}, "
+          f"max {stats['max']:.2e}; {covered.sum()} pixels covered by one only")
+    assert np.isfinite(image).all() and stats["count"] > 3000
+    assert stats["median"] <= 1e-3 and stats["p99"] <= 1e-2
+    assert covered.sum() <= 0.005 * (cycles.max(-1) > 0).sum()
+
+
 def test_export_refuses_what_it_cannot_describe(empty_scene, lut_dir, tmp_path):
     import bpy
 

@@ -44,6 +44,10 @@ EEVEE_P99_TOL = 3e-2
 #: The real-time backend's end-to-end targets (issue 13): GLSL on the exported scene vs Cycles' node render.
 GLSL_MEDIAN_TOL = 1e-4
 GLSL_P99_TOL = 1e-3
+#: The web viewer (engines/viewer, GLSL ES 3.00 in headless Chromium) against Cycles: issue 32's targets.  GLSL ES has
+#: no ``precise``: the driver may fuse and reorder the arithmetic the GLSL 4.50 renderer keeps in numpy's order.
+VIEWER_MEDIAN_TOL = 1e-3
+VIEWER_P99_TOL = 1e-2
 TARGET = 1e-2
 POSITIVE_FLOOR = 1e-3
 
@@ -118,10 +122,42 @@ def measure_realtime(scene, cycles, out_dir, lut_dir=None, repeats=5, log=print)
               "shader_cache_disabled": glsl_runner.shader_cache_disabled(), "first_frame_seconds": first, "frame_seconds_median": statistics.median(frames), "frame_seconds": frames,
               **timings}
     result["passed"] = bool(result["finite"] and stats["median"] <= GLSL_MEDIAN_TOL and stats["p99"] <= GLSL_P99_TOL)
+    # reported, not gated: on the demo scene the viewer misses issue 32's p99 (SwiftShader's arithmetic at grazing
+    # views; docs/realtime.md, "The web viewer")
+    result["viewer"] = measure_viewer(desc, cycles, out_dir, log)
     log(f"      GLSL ({why}): {result['programs']} programs compiled in {timings['compile_seconds']:.2f} s, frame "
         f"{result['frame_seconds_median'] * 1e3:.1f} ms (median of {repeats}; first {first:.2f} s); vs Cycles where > "
         f"{POSITIVE_FLOOR}: median {stats['median']:.2e}, p99 {stats['p99']:.2e}, max {stats['max']:.2e}; "
         f"{result['coverage_mismatch']} of {result['covered']} covered pixels covered in one render only")
+    return result
+
+
+def measure_viewer(desc, cycles, out_dir, log=print):
+    """The exported scene as a web bundle (``web_scene/``, core/export/web_scene.py) drawn by the viewer
+    (engines/viewer) in headless Chromium, against ``cycles``: the "viewer" entry of the realtime result, whose "passed" says whether
+    issue 32's targets are met (reported; the demo step does not gate on it).  Where node or Chromium is missing it
+    says so."""
+    from ...core.export import web_scene
+    from ..harness import three_browser
+    from ..harness.engines import compare
+
+    why = three_browser.missing()
+    if why:
+        log(f"      viewer not run: {why}")
+        return {"available": why}
+    web_scene.write_web(out_dir / "web_scene", desc)
+    image, info = three_browser.render_viewer(out_dir / "web_scene")
+    if image.shape != cycles.shape:
+        return {"available": "drawn", "passed": False, "error": f"viewer frame {image.shape} != Cycles {cycles.shape}"}
+    stats = compare(cycles, image, positive_floor=POSITIVE_FLOOR)
+    _png.write_rgb(out_dir / "viewer.png", _tonemap(image))
+    result = {"available": "drawn", "renderer": info["renderer"], "seconds": info["seconds"], "stats": stats,
+              "finite": bool(np.isfinite(image).all())}
+    result["passed"] = bool(result["finite"] and stats["median"] <= VIEWER_MEDIAN_TOL
+                            and stats["p99"] <= VIEWER_P99_TOL)
+    result["coverage_mismatch"] = int(((cycles.max(-1) > 0) != (image.max(-1) > 0)).sum())
+    log(f"      viewer (WebGL2 in headless Chromium, {info['seconds']:.1f} s): vs Cycles where > {POSITIVE_FLOOR}: "
+        f"median {stats['median']:.2e}, p99 {stats['p99']:.2e}, max {stats['max']:.2e}")
     return result
 
 
@@ -236,10 +272,22 @@ def format_markdown(result, image_prefix=""):
                   f"{s['median']:.2e}, p99 {s['p99']:.2e}, max {s['max']:.2e}; {rt['coverage_mismatch']} of "
                   f"{rt['covered']} covered pixels covered by one render only (targets: median <= {GLSL_MEDIAN_TOL}, "
                   f"p99 <= {GLSL_P99_TOL}): **{'PASS' if rt['passed'] else 'FAIL'}**", ""]
+        v = rt.get("viewer", {})
+        if "stats" in v:
+            s = v["stats"]
+            lines += [f"The web viewer (engines/viewer: the scene as a web bundle in `web_scene/`, drawn with WebGL2 "
+                      f"in headless Chromium, {v['seconds']:.1f} s with the browser's start) vs Cycles: median "
+                      f"{s['median']:.2e}, p99 {s['p99']:.2e}, max {s['max']:.2e}; {v['coverage_mismatch']} pixels "
+                      f"covered by one render only (issue 32's targets: median <= {VIEWER_MEDIAN_TOL}, p99 <= "
+                      f"{VIEWER_P99_TOL}: "
+                      f"**{'met' if v['passed'] else 'not met'}**; reported, not gated)", ""]
+        elif v:
+            lines += [f"The web viewer: not run ({v['available']}).", ""]
     elif rt:
         lines += [f"GLSL: not run ({rt['available']}).", ""]
     images = [("Cycles", "cycles.png"), ("EEVEE", "eevee.png"), ("EEVEE vs Cycles", "eevee_vs_cycles_rel.png"),
-              ("GLSL", "glsl.png"), ("GLSL vs Cycles (scale 0..1e-3)", "glsl_vs_cycles_rel.png")]
+              ("GLSL", "glsl.png"), ("GLSL vs Cycles (scale 0..1e-3)", "glsl_vs_cycles_rel.png"),
+              ("Web viewer", "viewer.png")]
     folder = Path(result.get("folder", "."))
     shown = [f"![{label}]({image_prefix}{name})" for label, name in images if (folder / name).exists()]
     if shown:

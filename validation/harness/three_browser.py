@@ -64,6 +64,25 @@ def _floats(b64):
     return np.frombuffer(base64.b64decode(b64), dtype="<f4").astype(np.float64)
 
 
+def run_node_tool(tool, args, out_name, timeout=600):
+    """Run ``engines/three/tools/<tool>`` with ``args`` (the output file's option last, ``--out``) and return its JSON
+    output; raises with node's output when it fails or the page reported errors."""
+    reason = missing()
+    if reason:
+        raise RuntimeError(f"three.js browser run impossible: {reason}")
+    with tempfile.TemporaryDirectory(prefix="rtl-browser-") as tmp:
+        out_path = Path(tmp) / out_name
+        proc = subprocess.run(["node", str(PACKAGE / "tools" / tool), *[str(a) for a in args], "--out", str(out_path)],
+                              cwd=PACKAGE, capture_output=True, text=True, timeout=timeout,
+                              env={**os.environ, "CHROMIUM": CHROMIUM})
+        if proc.returncode != 0 or not out_path.exists():
+            raise RuntimeError(f"{tool} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
+        raw = json.loads(out_path.read_text())
+    if raw.get("errors"):
+        raise RuntimeError(f"the page of {tool} reported errors: " + "; ".join(raw["errors"]))
+    return raw
+
+
 def render(spec, data_dir=None, timeout=600):
     """Run ``spec`` (harness.js' ``rtlRender`` fields, and ``loadTables``) in the browser; returns a ``Run``.
 
@@ -71,22 +90,11 @@ def render(spec, data_dir=None, timeout=600):
     ``rtl_*`` pairs) and the ``rtl`` layout's f32 EXRs in ``rtl/`` (the patched variants).
     """
     spec = dict(spec, dataUrl=spec.get("dataUrl", "/data/ltc_code/"), rtlUrl=spec.get("rtlUrl", "/data/rtl/"))
-    reason = missing()
-    if reason:
-        raise RuntimeError(f"three.js browser run impossible: {reason}")
     with tempfile.TemporaryDirectory(prefix="rtl-three-") as tmp:
-        spec_path, out_path = Path(tmp) / "spec.json", Path(tmp) / "result.json"
+        spec_path = Path(tmp) / "spec.json"
         spec_path.write_text(json.dumps(spec))
-        cmd = ["node", str(PACKAGE / "tools" / "render_cases.mjs"), "--spec", str(spec_path), "--out", str(out_path)]
-        if data_dir is not None:
-            cmd += ["--data", str(data_dir)]
-        proc = subprocess.run(cmd, cwd=PACKAGE, capture_output=True, text=True, timeout=timeout,
-                              env={**os.environ, "CHROMIUM": CHROMIUM})
-        if proc.returncode != 0 or not out_path.exists():
-            raise RuntimeError(f"render_cases.mjs failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
-        raw = json.loads(out_path.read_text())
-    if raw.get("errors"):
-        raise RuntimeError("the harness page reported errors: " + "; ".join(raw["errors"]))
+        args = ["--spec", spec_path] + (["--data", data_dir] if data_dir is not None else [])
+        raw = run_node_tool("render_cases.mjs", args, "result.json", timeout)
     configs = []
     for item in raw["results"]:
         positions = np.stack([_floats(item[k]) for k in ("x", "y", "z")], axis=-1)
@@ -212,3 +220,13 @@ def patched_reference(tables, config, lobe, roughness, sheen_roughness=0.5, spec
         return np.asarray(lobes.ZELTNER.function("quad", exact_horizon=True)(
             tables, **geometry, **{"Sheen Roughness": np.full(n, sheen_roughness)})["Sheen"])
     raise ValueError(f"unknown lobe {lobe!r}; choose from {', '.join(PATCH_VARIANTS)}")
+
+
+# --- the scene viewer (engines/viewer) --------------------------------------------------------------------------
+
+def render_viewer(bundle_dir, timeout=600):
+    """The viewer's first frame of a web bundle (core/export/web_scene.py) in headless Chromium: (H, W, 3) float32
+    radiance, row 0 at the top (as the standalone renderer and Blender's renders are read), and the run's info."""
+    raw = run_node_tool("render_viewer.mjs", ["--bundle", bundle_dir], "frame.json", timeout)
+    pixels = np.frombuffer(base64.b64decode(raw["pixels"]), dtype="<f4").reshape(raw["height"], raw["width"], 4)
+    return np.flipud(pixels[..., :3]).copy(), {"renderer": raw.get("renderer"), "seconds": raw["seconds"]}

@@ -8,10 +8,13 @@ import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 
 export const PACKAGE_ROOT = resolve( dirname( fileURLToPath( import.meta.url ) ), '..' );
+/** The scene viewer (engines/viewer), served at /viewer/. */
+export const VIEWER_ROOT = resolve( PACKAGE_ROOT, '..', 'viewer' );
 export const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
 
 const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json',
-	'.exr': 'application/octet-stream', '.ktx2': 'application/octet-stream', '.glsl': 'text/plain' };
+	'.exr': 'application/octet-stream', '.f32': 'application/octet-stream', '.bin': 'application/octet-stream',
+	'.vert': 'text/plain', '.frag': 'text/plain', '.ktx2': 'application/octet-stream', '.glsl': 'text/plain' };
 
 // Chromium (a fresh temporary profile per launch, playwright's default) as root in a sandboxless container, with nothing reaching out to the network (the machine's network is
 // closed: background services would fail their lookups at every start).
@@ -30,14 +33,15 @@ function serveFile( root, prefix, url, res ) {
 
 }
 
-/** Serves PACKAGE_ROOT at / and `dataDir` (if given) at /data/; resolves to { url, close }. */
+/** Serves PACKAGE_ROOT at /, VIEWER_ROOT at /viewer/ and `dataDir` (if given) at /data/; resolves to { url, close }. */
 export function startServer( dataDir = null ) {
 
 	const data = dataDir ? resolve( dataDir ) : null;
 	const server = createServer( ( req, res ) => {
 
 		const url = req.url.split( '?' )[ 0 ];
-		const ok = ( data && url.startsWith( '/data/' ) ) ? serveFile( data, '/data/', url, res ) : serveFile( PACKAGE_ROOT, '/', url, res );
+		const ok = ( data && url.startsWith( '/data/' ) ) ? serveFile( data, '/data/', url, res )
+			: url.startsWith( '/viewer/' ) ? serveFile( VIEWER_ROOT, '/viewer/', url, res ) : serveFile( PACKAGE_ROOT, '/', url, res );
 		if ( ! ok ) {
 
 			res.writeHead( 404 );
