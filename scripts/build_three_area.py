@@ -1,5 +1,6 @@
-"""Write engines/three/src/generated/rt_lit_area.js: RT Lit's area-light lobes emitted from the IR as GLSL ES 3.00 for
-the three.js patch (core/export/three_area.py).
+"""Write engines/three/src/generated/rt_lit_area.js, the three.js patch's GLSL ES 3.00 emitted from the IR.
+
+RT Lit's area-light lobes for engines/three's patchAreaLights (core/export/three_area.py).
 
     python scripts/build_three_area.py [--check]
 
