@@ -98,17 +98,7 @@ def measure(pairs, quads, seed=SEED, roughness=ROUGHNESS, progress=entry.quiet):
 
 def summarise(rows_by_r, names):
     """Error statistics per table: per roughness and pooled (every roughness's lights together)."""
-    result = {name: {"per_roughness": {}, "pooled": None} for name in names}
-    for name in names:
-        pooled = {k: [] for k in ("est", "truth", "albedo", "theta")}
-        for r, rows in rows_by_r.items():
-            result[name]["per_roughness"][str(r)] = ltc_random_lights.error_stats(
-                rows[name], rows["truth"], rows["albedo"], rows["theta"])
-            for k, src in (("est", name), ("truth", "truth"), ("albedo", "albedo"), ("theta", "theta")):
-                pooled[k] += list(rows[src])
-        result[name]["pooled"] = ltc_random_lights.error_stats(pooled["est"], pooled["truth"], pooled["albedo"],
-                                                               pooled["theta"])
-    return result
+    return ltc_random_lights.stats_by_roughness(rows_by_r, names)
 
 
 def paired_share(rows_by_r, ours="exported f32", theirs="published"):

@@ -122,6 +122,18 @@ def error_stats(est, truth, albedo, theta):
     return out
 
 
+def stats_by_roughness(rows_by_r, names):
+    """``error_stats`` per estimate name: per roughness and pooled (every roughness's lights together), from
+    ``rows_by_r[r] = {"truth", "albedo", "theta", name: estimates}``."""
+    result = {}
+    for name in names:
+        per_r = {str(r): error_stats(rows[name], rows["truth"], rows["albedo"], rows["theta"])
+                 for r, rows in rows_by_r.items()}
+        pooled = [sum((list(rows[k]) for rows in rows_by_r.values()), []) for k in (name, "truth", "albedo", "theta")]
+        result[name] = {"per_roughness": per_r, "pooled": error_stats(*pooled)}
+    return result
+
+
 def end_to_end(tables, published, n_quads, n_disks, seed=2019, prefixes=None):
     results = {}
     for prefix, (lobe_name, _) in catalog.LTC_LOBES.items():

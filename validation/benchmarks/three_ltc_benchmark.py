@@ -89,7 +89,7 @@ def configurations(count, seed=SEED):
     return out
 
 
-def truths(config, roughness, progress=entry.quiet):
+def truths(config, roughness):
     """Per pixel of one configuration: truth (n_r, n; NaN where the quadrature did not converge to
     REFERENCE_TOLERANCE), albedo (n_r, n) and view angle (n,)."""
     lobe = lobes.LOBES["ggx"]
@@ -161,21 +161,10 @@ def collect_rows(configs, truths_per_config, roughness, tables):
 def summarise(rows, tables):
     """Error statistics per table: per roughness and pooled over every roughness, on the pixels whose truth
     converged (``"unconverged"``: how many did not, per roughness)."""
-    rows = {r: _converged(rw) for r, rw in rows.items()}
-    out = {"unconverged": {str(r): rw["unconverged"] for r, rw in rows.items()}}
-    for t in tables:
-        per_r = {str(r): ltc_random_lights.error_stats(rw[t], rw["truth"], rw["albedo"], rw["theta"])
-                 for r, rw in rows.items()}
-        pooled = [sum((list(rw[k]) for rw in rows.values()), []) for k in (t, "truth", "albedo", "theta")]
-        out[t] = {"per_roughness": per_r, "pooled": ltc_random_lights.error_stats(*pooled)}
-    return out
-
-
-def _converged(rw):
-    keep = np.isfinite(np.asarray(rw["truth"], np.float64))
-    out = {k: list(np.asarray(v)[keep]) for k, v in rw.items()}
-    out["unconverged"] = int((~keep).sum())
-    return out
+    keep = {r: np.isfinite(np.asarray(rw["truth"], np.float64)) for r, rw in rows.items()}
+    converged = {r: {k: list(np.asarray(v)[keep[r]]) for k, v in rw.items()} for r, rw in rows.items()}
+    return {"unconverged": {str(r): int((~k).sum()) for r, k in keep.items()},
+            **ltc_random_lights.stats_by_roughness(converged, tables)}
 
 
 def acceptance(stats):
