@@ -211,6 +211,12 @@ class Updates:
         return self._changed
 
 
+def followed_objects():
+    """The light objects the handler holds between updates, in every scene it follows: what it reads at the next
+    update (none after a load or an undo or redo step, ``on_undo_step``)."""
+    return [obj for state in _states.values() for _, _, obj, _ in state.lights.values()]
+
+
 def _state(scene, updates=None):
     """``scene``'s ``_SceneState`` brought up to date with ``updates`` (checked in full without them, or when they
     name what only a full check follows); None when the file has no RT Lit group (nothing to keep in sync)."""
@@ -388,16 +394,36 @@ def on_load(*_):
     _failures.clear()
 
 
+@persistent
+def on_undo_step(*_):
+    """An undo or redo step: forget what the handler followed.  Blender's global undo reads the file state back into
+    new memory and frees the datablocks it replaces (an undone light among them), so the objects ``_SceneState`` holds
+    would be freed memory: reading one (the handler runs during the undo's own depsgraph update) crashes Blender.  The
+    next update checks the scene in full.  Failures are kept: they say what a sync needs, whatever the step."""
+    _states.clear()
+
+
+#: (handler list name, function): what this module adds to ``bpy.app.handlers``.
+_HANDLERS = (
+    ("depsgraph_update_post", on_depsgraph_update),
+    ("load_post", on_load),
+    ("undo_pre", on_undo_step),
+    ("undo_post", on_undo_step),
+    ("redo_pre", on_undo_step),
+    ("redo_post", on_undo_step),
+)
+
+
 def register():
-    if on_depsgraph_update not in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.append(on_depsgraph_update)
-    if on_load not in bpy.app.handlers.load_post:
-        bpy.app.handlers.load_post.append(on_load)
+    for name, function in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if function not in handlers:
+            handlers.append(function)
 
 
 def unregister():
-    if on_depsgraph_update in bpy.app.handlers.depsgraph_update_post:
-        bpy.app.handlers.depsgraph_update_post.remove(on_depsgraph_update)
-    if on_load in bpy.app.handlers.load_post:
-        bpy.app.handlers.load_post.remove(on_load)
+    for name, function in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if function in handlers:
+            handlers.remove(function)
     _states.clear()
