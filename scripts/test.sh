@@ -53,8 +53,11 @@ run_suite() {  # run_suite <release or ""> <junit xml or ""> [pytest args...]
         extra=()
         [[ -n "$xml" ]] && extra=(--junitxml "$xml")
         # the suite's tests are mostly one thread each (Python, bpy, one Cycles tile): a worker process per core
-        # (pytest-xdist); a module's tests stay on one worker, so its module fixtures run once
-        [[ "$workers" != 1 ]] && extra+=(-n "$workers" --dist loadscope)
+        # (pytest-xdist); a module's tests stay on one worker, so its module fixtures run once.  A worker that
+        # crashes ends the run (its test is reported as failed) rather than being replaced: pytest-xdist 3.8.0 can
+        # deadlock at the end of a --dist loadscope run after replacing a crashed worker (pytest-xdist #1378; a CI
+        # run hung until its time limit so)
+        [[ "$workers" != 1 ]] && extra+=(-n "$workers" --dist loadscope --max-worker-restart 0)
         python -m pytest "${paths[@]}" -q "${extra[@]}" "$@"
         rc=$?
         if [[ -n "$xml" ]]; then   # what the environment is, for the matrix table
