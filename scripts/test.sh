@@ -58,6 +58,8 @@ run_suite() {  # run_suite <release or ""> <junit xml or ""> [pytest args...]
         # deadlock at the end of a --dist loadscope run after replacing a crashed worker (pytest-xdist #1378; a CI
         # run hung until its time limit so)
         [[ "$workers" != 1 ]] && extra+=(-n "$workers" --dist loadscope --max-worker-restart 0)
+        # the slowest tests, in every log: where the suite's time goes (and how close any is to the timeout)
+        extra+=(--durations 12)
         python -m pytest "${paths[@]}" -q "${extra[@]}" "$@"
         rc=$?
         if [[ -n "$xml" ]]; then   # what the environment is, for the matrix table

@@ -157,7 +157,7 @@ print("RTL_RESULT " + json.dumps({"done": True}))
 def test_undo_and_redo_convert_and_sync_lights(lut_dir, tmp_path):
     """Undo after Convert gives the Principled material back; redo the RT Lit one.  Undo after adding and
     syncing a light removes both; redo brings both back.  In a fresh interpreter: Blender's global undo crashed once
-    in C in a test worker that had run other modules first (CI, 2026-12-05; not reproduced in 30 runs here), and a
+    in C in a CI test worker that had run other modules first (not reproduced in 30 runs here), and a
     crash there ends the whole run; here it fails this test, with the output."""
     from _blender_subprocess import run_snippet
 
