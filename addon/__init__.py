@@ -5,6 +5,8 @@ submodule defines its classes, and this module registers them in one ``classes``
 tuple (in order), then appends the ``menus`` entries; unregistering does both in reverse.
 Registration reads no file (it only checks that the preset library exists, to list it as an asset library).
 """
+import atexit
+
 import bpy
 
 from . import (compat, convert_ui, export_operators, light_controls, light_sync, lookdev_operators, operators,
@@ -36,9 +38,12 @@ def register():
     light_controls.register()
     light_sync.register()
     preset_assets.register_library()
+    if compat.module_exit_hangs_while_registered():
+        atexit.register(unregister)   # runs before bpy's own exit handler (atexit is last in, first out)
 
 
 def unregister():
+    atexit.unregister(unregister)
     preset_assets.unregister_library()
     light_sync.unregister()
     light_controls.unregister()

@@ -50,6 +50,13 @@ _EEVEE_RENAMED = (5, 0, 0)
 COMPOSITOR_NODE_GROUPS = (5, 0, 0)
 
 
+#: Before 5.0 the bpy *module* (``import bpy`` in CPython, not the Blender program) hangs for ever at process exit
+#: while any class or menu entry is still registered: its static destructor destroys the condition variable its
+#: audio device's delayed-close thread waits on (measured with 4.5.15: one registered operator is enough;
+#: 5.2 exits).  Unregistering first avoids it.
+_MODULE_EXIT_HANG_FIXED = (5, 0, 0)
+
+
 def srgb_decoding_error(release=None):
     """How far this release's sRGB decoding departs from IEC 61966-2-1 at most (measured)."""
     return 4e-7 if tuple(release or version()) >= (5, 0, 0) else 7.2e-6
@@ -62,6 +69,11 @@ def power_of_zero_is_zero(release=None):
 
 def version():
     return tuple(bpy.app.version)
+
+
+def module_exit_hangs_while_registered():
+    """True in a bpy module of a release whose process hangs at exit with classes still registered."""
+    return bpy.app.binary_path == "" and version() < _MODULE_EXIT_HANG_FIXED
 
 
 def supported(release=None):

@@ -163,3 +163,24 @@ def test_preferences_draw_lists_every_table(bpy_module, tmp_path):
             assert call[-1] in valid_icons | {'NONE'}, call
     assert str(tmp_path) in preferences._status_cache
     preferences.clear_status_cache()
+
+
+@pytest.mark.blender
+def test_a_python_process_with_the_add_on_registered_exits(tmp_path):
+    """``import bpy``, register, exit without unregistering: the process ends, cleanly.  Before 5.0 the bpy module
+    hangs for ever at exit while a class is registered (addon/compat.py, ``module_exit_hangs_while_registered``);
+    the add-on unregisters itself at exit there, once, even after an earlier register / unregister pair."""
+    from _blender_subprocess import run_snippet
+
+    code = textwrap.dedent(
+        """
+        import json
+        from rt_lookdev import addon
+        addon.register(); addon.unregister()
+        addon.register()
+        print("RTL_RESULT " + json.dumps({"registered": "RTL_OT_lut_status" in dir(bpy.types)}))
+        """
+    )
+    result, output = run_snippet(code, tmp_path / "user", timeout=120)
+    assert result == {"registered": True}
+    assert "Traceback" not in output and "Error in atexit" not in output, output

@@ -142,14 +142,16 @@ def undo_and_redo_convert_and_sync_lights(bpy, lut_dir):
 
 
 _UNDO_SNIPPET = r'''
-import json, sys
+import importlib.util, json, sys
 from pathlib import Path
-sys.path.insert(0, sys.argv[2])
 from rt_lookdev import addon
-from test_bad_input import undo_and_redo_convert_and_sync_lights
+# this test module, loaded from its file (tests are not a package; no sys.path edit)
+spec = importlib.util.spec_from_file_location("test_bad_input", sys.argv[2])
+test_bad_input = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(test_bad_input)
 addon.register()
 bpy.ops.wm.read_homefile(use_empty=True)
-undo_and_redo_convert_and_sync_lights(bpy, Path(sys.argv[1]))
+test_bad_input.undo_and_redo_convert_and_sync_lights(bpy, Path(sys.argv[1]))
 print("RTL_RESULT " + json.dumps({"done": True}))
 '''
 
@@ -161,7 +163,7 @@ def test_undo_and_redo_convert_and_sync_lights(lut_dir, tmp_path):
     crash there ends the whole run; here it fails this test, with the output."""
     from _blender_subprocess import run_snippet
 
-    result, _ = run_snippet(_UNDO_SNIPPET, tmp_path / "user", str(lut_dir), str(Path(__file__).parent))
+    result, _ = run_snippet(_UNDO_SNIPPET, tmp_path / "user", str(lut_dir), str(Path(__file__)))
     assert result == {"done": True}
 
 
