@@ -66,7 +66,7 @@ HORIZON_LABELS = {
     "exact_quads": ("Exact for Quads", "Quad lights clipped exactly at the surface's horizon, disk and sphere lights "
                     "by the talk's sphere table (a quad costs about 1.8x the talk's nodes). Blender 5.x: in 4.5 most "
                     "feature sets overflow Cycles' shader stack and render black"),
-    "exact": ("Exact", "Every area light clipped exactly at the surface's horizon: disks too, at about 9x the talk's "
+    "exact": ("Exact", "Every area light clipped exactly at the surface's horizon: disks too, at about 2.7x the talk's "
               "nodes per disk light. Blender 5.x: in 4.5 most feature sets overflow Cycles' shader stack"),
 }
 HORIZON_ITEMS = tuple((m, *HORIZON_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in HORIZON_MODELS)

@@ -392,49 +392,6 @@ def clipped_edge_terms(a, b, origin, sums=None, exact=False):
     return terms if sums is None else {name: sums[name] + value for name, value in terms.items()}
 
 
-# The equal-area polygon of a disk crossing the horizon (core/ltc/disk.py) is summed another way: each edge with its
-# connection to the next edge's clipped start (2K arcs, an edge wholly below collapsed onto the polygon's exit
-# point, repeated points adding nothing), the exit point found in a pass of its own, the edges' Area and Flow summed
-# apart.  It takes more operations than the running sums (2075 against 1155 for the disk's integral) but less of
-# Cycles' SVM stack in Blender 4.5: with the running sums a disk light with the Zeltner sheen overflowed it there.
-def _clip_point(above, point, other_above, crossing, exit_point):
-    """An edge end after clipping: the point itself when above; else the edge's crossing when the edge's other
-    end is above; else (the whole edge below) the polygon's exit point."""
-    return op.vselect(above, point, op.vselect(other_above, crossing, exit_point))
-
-
-def connected_edge_terms(a, b, c, exit_point, origin):
-    """{"Area", "Flow"} of the edge a -> b clipped at the horizon plus the arc to the clipped start of b -> c;
-    ``origin`` a point of the clipped polygon (not normalised)."""
-    o = op.normalize(origin)
-    x_ab, above_a, above_b = _horizon_crossing(a, b)
-    x_bc, _, above_c = _horizon_crossing(b, c)
-    start = op.normalize(_clip_point(above_a, a, above_b, x_ab, exit_point))
-    end = op.normalize(_clip_point(above_b, b, above_a, x_ab, exit_point))
-    following = op.normalize(_clip_point(above_b, b, above_c, x_bc, exit_point))
-    area1, flow1 = _arc_terms(start, end, o)
-    area2, flow2 = _arc_terms(end, following, o)
-    return {"Area": area1 + area2, "Flow": flow1 + flow2}
-
-
-def exit_part(a, b):
-    """The edge a -> b's share of the polygon's exit point: its crossing where it leaves the upper half-space
-    (a convex polygon has at most one such edge), else 0."""
-    x, above_a, above_b = _horizon_crossing(a, b)
-    return op.scale(x, above_a * (1.0 - above_b))
-
-
-def clipped_origin(a, b, exit_point):
-    """The clipped start of the edge a -> b: a point of the clipped polygon (the connected sum's origin)."""
-    x, above_a, above_b = _horizon_crossing(a, b)
-    return _clip_point(above_a, a, above_b, x, exit_point)
-
-
-def connected_sum_z(area, flow, origin):
-    """z of the clipped polygon's vector form factor from the connected edges' summed Area and Flow."""
-    return area + _cross_z(op.normalize(origin), flow)
-
-
 def clipped_sum_z(sums, origin, exact=False):
     """z of the clipped polygon's vector form factor from its edges' running sums: the closing arc from the exit
     point to the entry point along the horizon added, then the origin's part o x flow."""

@@ -229,7 +229,7 @@ def disney_sheen_fitted(tables, light, p, n, v, sheen_color):
 # Lambert is the identity LTC (Heitz et al. 2016, section 5): the light's exact form factor above the horizon.
 # Where the light crosses it the clipless form's sphere table stands for a cap far from the clipped polygon (issue
 # 30's minimal case: 0.00180 for 0.00034, +424%); a light with ``exact_horizon`` clips it (the quad exactly, with exact
-# edges; the disk by its closed form above the horizon and an equal-area 12-gon where it crosses).
+# edges; the disk by its closed form above the horizon and its clipped boundary integral where it crosses).
 def lambert(tables, light, p, n, v, albedo):
     """Lambert's form factor of the light (clipped at the horizon where the light says so) times ``albedo``."""
     frame = polygon.local_frame(n, v)

@@ -43,11 +43,11 @@ OCCLUSION_MODELS = ("none", "lagarde", "cones", "cones_clipped")
 #: How the lobes' LTC integrals meet the receiver's horizon under area lights (issue 30; docs/area_lights.md,
 #: "RT Lit's exact horizon"): "sphere_table" is the talk's clipless form for every light (Hill & Heitz 2017),
 #: "exact_quads" clips quad lights exactly at the horizon and leaves disks (and sphere lights) to the sphere table,
-#: "exact" clips disks too (an equal-area 12-gon where they cross it).  Measured (docs/benchmarks/horizon.md):
-#: clipping takes GGX under quads crossing the horizon from 17% to 3.5% p90 and Lambert to float precision, for
-#: ~1.8x a quad light's nodes; disks gain less for ~9x theirs.  The default stays the talk's form: in Blender
-#: 4.5 the clipped integrals overflow Cycles' SVM stack (black renders) for most feature sets (all fit in 5.2).
-#: The Zeltner sheen clips under all three.
+#: "exact" clips disks too (the clipped ellipse's boundary integral where they cross it).  Measured
+#: (docs/benchmarks/horizon.md): clipping takes GGX under quads crossing the horizon from 17% to 3.5% p90 and Lambert
+#: to float precision, for ~1.8x a quad light's nodes; disks (Lambert to 5e-7) for ~2.7x theirs.  The default stays
+#: the talk's form: in Blender 4.5 the clipped integrals overflow Cycles' SVM stack (black renders) for most feature
+#: sets (all fit in 5.2).  The Zeltner sheen clips under all three.
 HORIZON_MODELS = ("sphere_table", "exact_quads", "exact")
 #: The model an artist gets when switching world occlusion on (the Convert dialog, New Lookdev Scene).
 DEFAULT_OCCLUSION = "cones_clipped"

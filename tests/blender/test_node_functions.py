@@ -77,9 +77,9 @@ def test_area_lobe_groups_match_numpy(empty_scene, tables, kind, lobe):
 
 
 # Exact horizons (Features.horizon, issue 30) render as numpy where they fit Cycles' SVM stack in Blender 4.5 too (in
-# 5.2 every lobe and feature set fits); GGX under a clipped disk does not fit 4.5's.
+# 5.2 every lobe and feature set fits).
 @pytest.mark.parametrize("kind, lobe", [("quad", "lambert"), ("quad", "ggx"), ("quad", "cod"), ("disk", "lambert"),
-                                        ("disk", "cod")])
+                                        ("disk", "cod"), ("disk", "ggx")])
 def test_exact_horizon_groups_match_numpy(empty_scene, tables, kind, lobe):
     from rt_lookdev.core.materials import light_shading
     from rt_lookdev.core.materials.rt_lit_interface import Features

@@ -11,7 +11,7 @@ drawn within 25 degrees of the horizon); the *above* set the lights wholly above
 -20 degrees up), so both come from one generator and differ only in where the light lies.
 
 Lambert: ``core.ltc.shading.lambert`` with the exact horizon (quads clipped, disks by their closed form above the
-horizon and an equal-area 12-gon clipped where they cross it; numpy float64 and float32) and with the talk's
+horizon and the clipped ellipse's boundary integral where they cross it; numpy float64 and float32) and with the talk's
 clipless form (the identity LTC with the sphere table's horizon), against the clipped form factor by quadrature
 (``core.ltc.reference``), relative error over every light whose form factor is above 1e-6.
 Every LTC lobe (``catalog.LTC_LOBES``, with its band where it has one): ``shading.lobe_integral`` x the table's

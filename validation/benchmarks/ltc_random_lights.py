@@ -217,7 +217,7 @@ def zeltner_exactness(lut_dir, n_quads, n_disks, seed=2022):
     """The Zeltner sheen's area form vs brute force of the same lobe (the LTC density times the albedo at the
     same table values): the LTC integral with the sphere table's horizon ("sphere table") and with the exact
     horizon RT Lit shades it with ("exact horizon": quads clipped, disks by their closed form above the
-    horizon and an equal-area 12-gon clipped where they cross it).  Random sheen roughness in [0.05, 1]."""
+    horizon and the clipped ellipse's boundary integral where they cross it).  Random sheen roughness in [0.05, 1]."""
     tables = lookup.LutSet.from_folder(lut_dir)
     sheen_table = tables.array("zeltner_sheen")
     sphere = tables.array("ltc_ggx_mag")[..., 3]
