@@ -288,13 +288,15 @@ def arc_form_factor_z(c, v1, v2):
     """z of the vector form factor of the ellipse (centre c, semi-diameters v1, v2, winding v1 -> v2) clipped to
     z >= 0; traceable.
 
-    Stokes' theorem turns the form factor of a region seen from the origin into a line integral along its boundary,
-    F = 1/(2 pi) * closed integral of (p x dp) / |p|^2 (Arvo 1995, "Applications of Irradiance Tensors", eq. 9; for a
-    polygon's straight edge it gives the familiar theta * normalize(p_i x p_i+1)).  Above the horizon the boundary
-    is an arc of the ellipse, p(t) = c + u cos t + v sin t with (u, v) the semi-diameters turned so that u.z is the
-    largest height of the rim and v.z = 0 (the same winding); the arc is t in [-h, h] with cos h = -c.z / u.z.  On it
-    (p x p').z = (u x v).z + (c x p').z with (c x p').z = (c x v).z cos t - (c x u).z sin t, over |p|^2: smooth
-    unless the rim passes close to the point, integrated by Gauss-Legendre (``ARC_POINTS``).  The rest of the
+    Stokes' theorem turns the vector form factor of a region seen from the origin into a line integral along its
+    boundary, F = 1/(2 pi) * closed integral of (p x dp) / |p|^2: Lambert's formula for a polygon (Arvo 1995,
+    "Applications of Irradiance Tensors to the Simulation of Non-Lambertian Phenomena": theta_i times
+    normalize(p_i x p_i+1) per edge) is its value for straight edges, and a curve is the limit of short ones.
+    Above the horizon the boundary is an arc of the ellipse, p(t) = c + u cos t + v sin t with (u, v) the
+    semi-diameters turned so that u.z is the largest height of the rim and v.z = 0 (the same winding); the arc is
+    t in [-h, h] with cos h = -c.z / u.z.  On it (p x p').z = (u x v).z + (c x p').z with
+    (c x p').z = (c x v).z cos t - (c x u).z sin t, over |p|^2: smooth unless the rim passes close to the point,
+    integrated by Gauss-Legendre (``ARC_POINTS``).  The rest of the
     boundary is the chord in the plane z = 0, whose term is exactly the signed angle between its ends.  Wholly above:
     h = pi (the whole ellipse, a chord of zero length); wholly below: h = 0 (nothing).
 
