@@ -22,10 +22,10 @@ light with spread as (this project's construction; docs/blender.md, "Spread"):
 2. each lobe's LTC integral over that region at the light's radiance L, times
 3. the average of w over the region weighted by that lobe's own kernel (``lobe_average``), by a
    Gauss rule on the region: on a quad 5 x 5 Gauss-Legendre points moved towards where the lobe's axis meets
-   the quad's plane (``quad_points``: a narrow lobe falls between the plain rule's points), on a disk 3 radial
-   x 8 angular points about the foot over the light's own disk cut by the cone's circle (``lens_samples``:
+   the quad's plane (``QUAD_RULE``: a narrow lobe falls between the plain rule's points), on a disk 3 radial
+   x 8 angular points about the foot over the light's own disk cut by the cone's circle (``DISK_RULE``:
    the region shaded there is an ellipse fitted to that lens), or for a narrow lobe the quad's warped rule
-   carried onto the disk (``warped_disk_rule``); exact where w is constant, and where the region is much larger
+   carried onto the disk (``DISK_RULE``); exact where w is constant, and where the region is much larger
    than the cone it finds the cone.
 
 The kernel of an LTC with inverse matrix Minv, over the light's area, is max((Minv x).z, 0) / |Minv x|^4
@@ -46,7 +46,7 @@ median / p90 / max over 40 quads, spread 60 deg: with each lobe's kernel and the
 0.21% / 1.6% / 44%, 0.13% / 0.77% / 4.0%; with Lambert's kernel, as before issue 27 (80 quads, random spreads):
 15% / 119% / 4040%, 8.4% / 45% / 119% and 0.66% / 3.0% / 7%.  Disks of radius 0.3-1 m at 0.6-2 m, spread 90 deg
 (30 receivers; tests/core/test_lights.py checks Lambert and r = 0.1), median / p90: Lambert 0.36% / 2.7%, r = 0.4
-0.81% / 2.6%, r = 1 0.32% / 2.6% (broad lobes: ``lens_samples`` over the true overlap; averaged over the overlap's
+0.81% / 2.6%, r = 1 0.32% / 2.6% (broad lobes: ``DISK_RULE`` over the true overlap; averaged over the overlap's
 fitted ellipse with the polar rule, before: 1.4% / 8.3%, 2.6% / 9.1%, 1.4% / 8.4%), r = 0.1 1.2% / 15% (the warped
 rule; the polar rule, before: 13% / 53%).  Cost: the warped rules add IR operations to each lobe of a light with
 spread (Turquin + CoD, one light: quad 2524 -> 3430, disk 2310 -> 6078; a light without spread is unchanged).
@@ -59,6 +59,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import shading_ops as op
+from .ir.functions import NodeFunction
+from .ir.interface import scalar, vector
 
 #: Smallest half-spread taken (0.25 deg): below it tan(h) - h underflows float32; Cycles' own floor is 0.05 deg.
 MIN_HALF_SPREAD = math.radians(0.25)
@@ -90,7 +92,7 @@ class SpreadCone:
     projection on the plane, world space), ``radius`` R = t tan h (t the point's distance from the plane; 1e30 at
     180 deg: ``FULL_RADIUS``, where the weight is 1 everywhere: Cycles takes tan(h) = FLT_MAX) and ``scale`` c (1 at 180 deg);
     for a disk light, ``disk``: the light's own (centre, axis_u, axis_v), over whose overlap with the cone's circle
-    ``lens_samples`` averages (None: the average is over the region shaded)."""
+    ``DISK_RULE`` averages (None: the average is over the region shaded)."""
     foot: object
     radius: object
     scale: object
@@ -189,17 +191,6 @@ def lobe_footprint(a, b, e):
     return op.select(faces, x_peak, 0.0), op.select(faces, y_peak, 0.0), along(b), along(e), faces
 
 
-def quad_points(a, b, e):
-    """The quad's rule, points (x, y, weight) of ``centre + axis_u x + axis_v y`` over [-1, 1]^2, for the lobe whose
-    space holds the quad as a + b x + e y: the warped Gauss rule of each axis (``warped_gauss``) about the point
-    where the lobe's axis meets the quad's plane, with the lobe's footprint there (``lobe_footprint``; the plain
-    5 x 5 Gauss rule, nearly, where the lobe is broad or faces away from the plane)."""
-    x_peak, y_peak, footprint_x, footprint_y, _ = lobe_footprint(a, b, e)
-    xs = warped_gauss(op.clamp(x_peak, -PEAK_LIMIT, PEAK_LIMIT), footprint_x)
-    ys = warped_gauss(op.clamp(y_peak, -PEAK_LIMIT, PEAK_LIMIT), footprint_y)
-    return [(x, y, wx * wy) for x, wx in xs for y, wy in ys]
-
-
 def _square_from_disk(x, y):
     """The inverse of the elliptical grid map (x, y) -> (x sqrt(1 - y^2 / 2), y sqrt(1 - x^2 / 2)) of the square
     [-1, 1]^2 onto the unit disk (Fong 2015, "Analytical methods for squaring the disc"), for a point of the disk:
@@ -212,117 +203,358 @@ def _square_from_disk(x, y):
 
 #: How far inside the disk's rim (radius 1) the lobe's peak is pulled for the warped disk rule.
 DISK_PEAK_LIMIT = 0.999
-#: A lobe whose footprint (``quad_points``) is below this many of the disk's semi-axes along either axis takes the
-#: warped rule, a broader one the polar rule about the cone's foot (``lens_samples``): exact along each ray for the
+#: A lobe whose footprint (``lobe_footprint``) is below this many of the disk's semi-axes along either axis takes the
+#: warped rule, a broader one the polar rule about the cone's foot (``DISK_RULE``): exact along each ray for the
 #: cone, where the warped rule for every lobe put a Lambert receiver 3% off, the cone's apex between its points
 #: (tests/blender/test_light_model.py, spread 40 deg).
 #: Validation suite, spread_disk GGX r = 0.4, median: 0.5 4.5%, 1.0 8.7%.
 NARROW_FOOTPRINT = 0.5
 
 
-def warped_disk_points(x_peak, y_peak, footprint_x, footprint_y):
-    """The warped rule on the unit disk: ``warped_gauss`` on the square about the square's image of the lobe's peak
-    (pulled into the disk), carried onto the disk by the elliptical grid map, whose Jacobian is
-    (1 - (x^2 + y^2) / 2) / (sqrt(1 - x^2 / 2) sqrt(1 - y^2 / 2)) (0 only at the square's corners)."""
+def warped_disk_axes(x_peak, y_peak, footprint_x, footprint_y):
+    """The warped rule on the unit disk, per axis: ``warped_gauss`` on the square about the square's image of the
+    lobe's peak (pulled into the disk), [(x, weight, sqrt(1 - x^2 / 2))] along each axis of the square; the points are
+    their products carried onto the disk by the elliptical grid map (``disk_grid_point``)."""
     radius = op.sqrt(x_peak * x_peak + y_peak * y_peak)
     pull = op.safe_div(op.minimum(radius, DISK_PEAK_LIMIT), radius)
     x_square, y_square = _square_from_disk(x_peak * pull, y_peak * pull)
-    xs = [(x, w, op.sqrt(1.0 - 0.5 * x * x)) for x, w in warped_gauss(x_square, footprint_x)]
-    ys = [(y, w, op.sqrt(1.0 - 0.5 * y * y)) for y, w in warped_gauss(y_square, footprint_y)]
-    return [(x * y_stretch, y * x_stretch,
-             wx * wy * op.safe_div(1.0 - 0.5 * (x * x + y * y), x_stretch * y_stretch))
-            for x, wx, x_stretch in xs for y, wy, y_stretch in ys]
+    xs = [(x, w, op.sqrt(1.0 - 0.5 * x * x)) for x, w in warped_gauss_rule(x_square, footprint_x)]
+    ys = [(y, w, op.sqrt(1.0 - 0.5 * y * y)) for y, w in warped_gauss_rule(y_square, footprint_y)]
+    return xs, ys
+
+
+def disk_grid_point(x, wx, x_stretch, y, wy, y_stretch):
+    """(x', y', weight): the point (x, y) of the square carried onto the disk by the elliptical grid map, its weight
+    times the map's Jacobian (1 - (x^2 + y^2) / 2) / (sqrt(1 - x^2 / 2) sqrt(1 - y^2 / 2)) (0 only at the square's
+    corners)."""
+    return (x * y_stretch, y * x_stretch,
+            wx * wy * op.safe_div(1.0 - 0.5 * (x * x + y * y), x_stretch * y_stretch))
 
 
 def warped_disk_rule(a, b, e):
-    """(narrow, points): whether the lobe whose space holds the disk as a + b x + e y is narrow (``NARROW_FOOTPRINT``)
-    and faces the disk's plane, and the warped rule's points for it (``warped_disk_points``)."""
+    """(narrow, xs, ys): whether the lobe whose space holds the disk as a + b x + e y is narrow (``NARROW_FOOTPRINT``)
+    and faces the disk's plane, and the warped rule's axes for it (``warped_disk_axes``)."""
     x_peak, y_peak, footprint_x, footprint_y, faces = lobe_footprint(a, b, e)
     narrow = op.logical_and(faces, op.less(op.minimum(footprint_x, footprint_y), NARROW_FOOTPRINT))
-    return narrow, warped_disk_points(x_peak, y_peak, footprint_x, footprint_y)
+    return (narrow, *warped_disk_axes(x_peak, y_peak, footprint_x, footprint_y))
 
 
-#: The lens rule's Gauss-Legendre points: angles about the foot, and along each ray (``lens_samples``).
+#: The lens rule's Gauss-Legendre points: angles about the foot, and along each ray (``_lens_ray``).
 LENS_ANGLES, LENS_ANGLE_WEIGHTS = (tuple(float(x) for x in a) for a in np.polynomial.legendre.leggauss(8))
 LENS_RADII, LENS_RADIAL_WEIGHTS = (tuple(float(x) for x in a) for a in np.polynomial.legendre.leggauss(3))
 
 
-def lens_samples(cone, position, to_lobe, inv_size):
-    """(m, weight, spread weight) of a polar rule about the cone's foot over the light's own disk (``cone.disk``) cut
-    by the cone's circle: the angles that see the disk (all, or the 2 asin(1 / d) of a foot d semi-axes outside
-    its bounding circle), on each ray the stretch inside the ellipse (a quadratic in rho) and within R.  The weight
-    is linear along each ray, so this rule finds a disk's overlap with the cone, a lens, exactly where the region
-    shaded is only its fitted ellipse (``spread_disk``).  m in the lobe's space scaled by ``inv_size`` (as
-    ``lobe_average``'s); lengths in units of the disk's larger semi-axis; padded with points of weight 0 to the
-    warped rule's count (``lobe_average`` picks one rule's point or the other's per point)."""
+# --- the rules as node functions -------------------------------------------------------------------------------
+# The rules are node functions (node groups shared by every lobe and light; functions in shader text) of at most
+# addon/node_emit.py's MAX_GROUP_NODES nodes each: written inline, a disk light's rule made each lobe of it one flat
+# group of 1,800-3,200 nodes, which Blender took 78-137 s to build for one Lambert material (docs/blender.md, "Node
+# groups").  The values are the same to the bit: the same operations in the same order, the running sums passed from
+# point to point.
+
+def _sockets(vectors, scalars):
+    out = {name: vector(text) for name, text in vectors.items()}
+    out.update({name: scalar(0.0, text) for name, text in scalars.items()})
+    return out
+
+
+def _warped_gauss(**kw):
+    rule = warped_gauss(kw["Peak"], kw["Footprint"])
+    return {**{f"X {i}": x for i, (x, _) in enumerate(rule)}, **{f"Weight {i}": w for i, (_, w) in enumerate(rule)}}
+
+
+WARPED_GAUSS = NodeFunction(
+    "RTL Spread Warped Gauss", _warped_gauss,
+    _sockets({}, {"Peak": "Where the lobe's axis meets the axis, in units of the half-extent",
+                  "Footprint": "The lobe's footprint along the axis, in units of the half-extent"}),
+    {**{f"X {i}": scalar(0.0, f"Point {i}") for i in range(len(QUAD_NODES))},
+     **{f"Weight {i}": scalar(0.0, f"Weight of point {i}") for i in range(len(QUAD_NODES))}},
+    "Gauss-Legendre points on [-1, 1] moved towards a lobe's peak by a sinh map (Johnston & Elliott 2005; "
+    "core/light_spread.py, warped_gauss)")
+
+
+def warped_gauss_rule(peak, footprint):
+    """``warped_gauss`` as one call of ``WARPED_GAUSS``: [(x, weight)]."""
+    out = WARPED_GAUSS(Peak=peak, Footprint=footprint)
+    return [(out[f"X {i}"], out[f"Weight {i}"]) for i in range(len(QUAD_NODES))]
+
+
+def kernel_terms(m, w, spread_w):
+    """(kernel, kernel x spread weight) of one rule point at m in the lobe's space with the rule's weight w: the
+    lobe's kernel max(m.z, 0) w / |m|^4 (module docstring), |m|^2 at least KERNEL_FLOOR."""
+    m2 = op.maximum(op.dot(m, m), KERNEL_FLOOR)
+    kernel = op.safe_div(op.maximum(op.component(m, 2), 0.0) * w, m2 * m2)
+    return kernel, kernel * spread_w
+
+
+#: The running sums a rule's points pass on (each point adds its kernel terms in order).
+_SUMS = {"Total": scalar(0.0, "The rule's sum of the kernel"),
+         "Weighted": scalar(0.0, "The rule's sum of the kernel times the spread's weight")}
+_SUM_TEXTS = {"Total": "The kernel summed over the points before", "Weighted": "The weighted kernel, likewise"}
+
+
+def _add_point(kw, kernel, weighted):
+    """The running sums with one point's kernel terms added."""
+    return {"Total": kernel + kw["Total"], "Weighted": weighted + kw["Weighted"]}
+
+
+def _region_point(**kw):
+    """One point of the region ``centre + axis_u x + axis_v y``: its kernel terms (``kernel_terms``) at m = (a + b x) +
+    e y in the lobe's space, the spread's weight at its distance |(g + axis_u x) + axis_v y| from the cone's foot (g
+    the centre's offset from the foot), added to the running sums.  The parts along each axis are inputs, so that a
+    rule on a grid forms each once (``_quad_rule``)."""
+    rho = op.length(kw["Foot X"] + kw["Foot Y"])
+    return _add_point(kw, *kernel_terms(kw["Lobe X"] + kw["Lobe Y"], kw["Weight"],
+                                        spread_weight(rho, kw["Cone Radius"], kw["Cone Scale"])))
+
+
+_CONE_SCALARS = {"Cone Radius": "The spread cone's radius R on the light's plane",
+                 "Cone Scale": "The spread's normalisation c"}
+
+REGION_POINT = NodeFunction(
+    "RTL Spread Region Point", _region_point,
+    _sockets({"Lobe X": "A + B x: the point's part along its first axis, in the lobe's space",
+              "Lobe Y": "E y: its part along the second", "Foot X": "G + Axis U x: from the cone's foot, world",
+              "Foot Y": "Axis V y"}, {"Weight": "The rule's weight of the point", **_CONE_SCALARS, **_SUM_TEXTS}),
+    _SUMS, "One point of a spread rule on a quad: the lobe's kernel and the spread's weight there, added to the "
+           "running sums (core/light_spread.py)")
+
+
+def _quad_row(**kw):
+    """The five points of the quad's rule at one x, added to the running sums in order (``REGION_POINT``)."""
+    sums = {"Total": kw["Total"], "Weighted": kw["Weighted"]}
+    for j in range(len(QUAD_NODES)):
+        sums = REGION_POINT(**{"Lobe X": kw["Lobe X"], "Foot X": kw["Foot X"], "Lobe Y": kw[f"Lobe Y {j}"],
+                               "Foot Y": kw[f"Foot Y {j}"], "Weight": kw["X Weight"] * kw[f"Y Weight {j}"],
+                               "Cone Radius": kw["Cone Radius"], "Cone Scale": kw["Cone Scale"], **sums})
+    return sums
+
+
+QUAD_ROW = NodeFunction(
+    "RTL Spread Quad Row", _quad_row,
+    _sockets({"Lobe X": "A + B x in the lobe's space", "Foot X": "G + Axis U x (world)",
+              **{f"{name} {j}": f"{text} of point {j}" for j in range(len(QUAD_NODES))
+                 for name, text in (("Lobe Y", "E y"), ("Foot Y", "Axis V y"))}},
+             {"X Weight": "The row's weight", **{f"Y Weight {j}": f"The weight of point {j}"
+                                                 for j in range(len(QUAD_NODES))},
+              **_CONE_SCALARS, **_SUM_TEXTS}),
+    _SUMS, "One row of the spread's rule on a quad, added to the running sums (core/light_spread.py)")
+
+#: The region's geometry every rule on it takes (``lobe_average``).
+_REGION_VECTORS = {"A": "The region's centre in the lobe's space, scaled (lobe_average)",
+                   "B": "The region's first half-axis in the lobe's space, scaled",
+                   "E": "The region's second half-axis in the lobe's space, scaled",
+                   "G": "The region's centre less the cone's foot (world)",
+                   "Axis U": "The region's first half-axis (world)", "Axis V": "The region's second half-axis (world)"}
+
+
+def _quad_rule(**region):
+    """The quad's rule over [-1, 1]^2, for the lobe whose space holds the quad as a + b x + e y: the warped Gauss rule
+    of each axis (``warped_gauss``) about the point where the lobe's axis meets the quad's plane, with the lobe's
+    footprint there (``lobe_footprint``; the plain 5 x 5 Gauss rule, nearly, where the lobe is broad or faces away
+    from the plane); each axis's parts of the points formed once, the rows summed in order (``QUAD_ROW``)."""
+    x_peak, y_peak, footprint_x, footprint_y, _ = lobe_footprint(region["A"], region["B"], region["E"])
+    xs = warped_gauss_rule(op.clamp(x_peak, -PEAK_LIMIT, PEAK_LIMIT), footprint_x)
+    ys = warped_gauss_rule(op.clamp(y_peak, -PEAK_LIMIT, PEAK_LIMIT), footprint_y)
+    columns = {}
+    for j, (y, wy) in enumerate(ys):
+        columns.update({f"Lobe Y {j}": op.scale(region["E"], y), f"Foot Y {j}": op.scale(region["Axis V"], y),
+                        f"Y Weight {j}": wy})
+    sums = {"Total": 0.0, "Weighted": 0.0}
+    for x, wx in xs:
+        sums = QUAD_ROW(**{"Lobe X": region["A"] + op.scale(region["B"], x),
+                           "Foot X": region["G"] + op.scale(region["Axis U"], x), "X Weight": wx, **columns,
+                           "Cone Radius": region["Cone Radius"], "Cone Scale": region["Cone Scale"], **sums})
+    return sums
+
+
+QUAD_RULE = NodeFunction(
+    "RTL Spread Quad Rule", _quad_rule, _sockets(_REGION_VECTORS, _CONE_SCALARS), _SUMS,
+    "The spread's rule on a quad: the warped 5 x 5 Gauss rule about the lobe's peak (core/light_spread.py, "
+    "_quad_rule)")
+
+#: The square's axes of the warped disk rule (``warped_disk_axes``): per axis its points, weights and stretches.
+_AXES = {f"{axis} {part} {i}": f"The square's {axis.lower()}-axis {part.lower()} {i}"
+         for axis in ("X", "Y") for part in ("Node", "Weight", "Stretch") for i in range(len(QUAD_NODES))}
+
+
+def _disk_warped_axes(**kw):
+    narrow, xs, ys = warped_disk_rule(kw["A"], kw["B"], kw["E"])
+    out = {"Narrow": op.select(narrow, 1.0, 0.0)}
+    for axis, values in (("X", xs), ("Y", ys)):
+        for i, point in enumerate(values):
+            out.update({f"{axis} {part} {i}": v for part, v in zip(("Node", "Weight", "Stretch"), point)})
+    return out
+
+
+DISK_WARPED_AXES = NodeFunction(
+    "RTL Spread Disk Warped Axes", _disk_warped_axes, _sockets({k: _REGION_VECTORS[k] for k in "ABE"}, {}),
+    {"Narrow": scalar(0.0, "1 where the lobe is narrow and faces the disk (NARROW_FOOTPRINT): the warped rule"),
+     **{name: scalar(0.0, text) for name, text in _AXES.items()}},
+    "The warped disk rule's axes on the square (core/light_spread.py, warped_disk_rule)")
+
+#: A lens-rule point before its kernel: where it lies in the lobe's space, the rule's weight, the spread's weight.
+_POINT = {"M": vector("The point in the lobe's space"), "Weight": scalar(0.0, "The rule's weight of the point"),
+          "Spread Weight": scalar(0.0, "The spread's weight at the point")}
+
+
+def _disk_point(**kw):
+    """A point of the disk's rule, added to the running sums: for a narrow lobe the warped rule's, the square's
+    point (x, y) carried onto the disk (``disk_grid_point``), else the lens rule's (given)."""
+    x, y, w = disk_grid_point(kw["X"], kw["X Weight"], kw["X Stretch"], kw["Y"], kw["Y Weight"], kw["Y Stretch"])
+    (lobe_x, foot_x), (lobe_y, foot_y) = _point_parts(kw, x, y)
+    spread_w = spread_weight(op.length(foot_x + foot_y), kw["Cone Radius"], kw["Cone Scale"])
+    narrow = kw["Narrow"]
+    return _add_point(kw, *kernel_terms(op.vselect(narrow, lobe_x + lobe_y, kw["M Lens"]),
+                                        op.select(narrow, w, kw["Weight Lens"]),
+                                        op.select(narrow, spread_w, kw["Spread Weight Lens"])))
+
+
+def _point_parts(region, x, y):
+    """The parts along each axis of the point (x, y) of ``centre + axis_u x + axis_v y``: ((a + b x, g + axis_u x),
+    (e y, axis_v y)), in the lobe's space and from the cone's foot."""
+    return ((region["A"] + op.scale(region["B"], x), region["G"] + op.scale(region["Axis U"], x)),
+            (op.scale(region["E"], y), op.scale(region["Axis V"], y)))
+
+
+DISK_POINT = NodeFunction(
+    "RTL Spread Disk Point", _disk_point,
+    _sockets(_REGION_VECTORS, {"Narrow": "1: the warped rule's point, 0: the lens rule's",
+                               **{f"{axis}{part}": f"The square's {axis.lower()}-axis {what}"
+                                  for axis in ("X", "Y") for part, what in (("", "node"), (" Weight", "weight"),
+                                                                           (" Stretch", "stretch"))},
+                               **_CONE_SCALARS, **_SUM_TEXTS})
+    | {f"{name} Lens": socket for name, socket in _POINT.items()},
+    _SUMS, "One point of the spread's rule on a disk, the warped rule's or the lens rule's, added to the running sums "
+           "(core/light_spread.py)")
+
+#: The lens rule's inputs (``lens_inputs``): the foot and the disk's axes in the lobe's space, the disk in units of
+#: its larger semi-axis.
+_LENS_VECTORS = {"Base": "The cone's foot in the lobe's space, scaled (lobe_average)",
+                 "Along U": "The disk's first unit axis in the lobe's space, times its larger semi-axis, scaled",
+                 "Along V": "The disk's second unit axis in the lobe's space, likewise"}
+_LENS_SCALARS = {"Foot U": "The foot along the disk's first axis, in units of its larger semi-axis",
+                 "Foot V": "The foot along the second axis, likewise",
+                 "Inv U2": "(larger semi-axis / first semi-axis)^2", "Inv V2": "(larger semi-axis / second semi-axis)^2",
+                 "Reach": "The cone's radius in units of the disk's larger semi-axis"}
+_RAY_SCALARS = {"Outside": "The foot's level in the ellipse's metric less 1 (> 0: outside the disk)",
+                "Towards": "The angle towards the disk's centre", "Half Angle": "Half the angle that sees the disk",
+                "Node": "The ray's Gauss-Legendre node in [-1, 1]", "Cone Scale": "The spread's normalisation c"}
+_RAY_WEIGHTS = {f"Weight {j}": f"The ray's angular weight times its point {j}'s radial weight" for j in range(3)}
+
+
+def _lens_ray(**kw):
+    """The lens rule's three points on the ray at the angle towards + half_angle node about the foot: the stretch
+    of the ray inside the ellipse (a quadratic in rho) and within the reach, by Gauss-Legendre."""
+    inv_u2, inv_v2, foot_u, foot_v = kw["Inv U2"], kw["Inv V2"], kw["Foot U"], kw["Foot V"]
+    phi = kw["Towards"] + kw["Half Angle"] * kw["Node"]
+    c, s = op.cos(phi), op.sin(phi)
+    # |foot + rho (c, s)| = 1 in the ellipse's metric: q2 rho^2 + q1 rho + outside = 0
+    q2 = c * c * inv_u2 + s * s * inv_v2
+    q1 = 2.0 * (foot_u * c * inv_u2 + foot_v * s * inv_v2)
+    root = op.sqrt(q1 * q1 - 4.0 * q2 * kw["Outside"])
+    near = op.minimum(op.maximum(op.safe_div(-q1 - root, 2.0 * q2), 0.0), kw["Reach"])
+    far = op.minimum(op.maximum(op.safe_div(-q1 + root, 2.0 * q2), near), kw["Reach"])
+    half = (far - near) * 0.5
+    direction = op.scale(kw["Along U"], c) + op.scale(kw["Along V"], s)
+    out = {}
+    for j, radial in enumerate(LENS_RADII):
+        rho = near + half + half * radial
+        out[f"M {j}"] = kw["Base"] + op.scale(direction, rho)
+        out[f"Weight {j}"] = kw["Half Angle"] * kw[f"Weight {j}"] * half * rho
+        out[f"Spread Weight {j}"] = spread_weight(rho, kw["Reach"], kw["Cone Scale"])
+    return out
+
+
+LENS_RAY = NodeFunction(
+    "RTL Spread Lens Ray", _lens_ray, _sockets(_LENS_VECTORS, {**_LENS_SCALARS, **_RAY_SCALARS, **_RAY_WEIGHTS}),
+    {f"{name} {j}": socket for j in range(3) for name, socket in _POINT.items()},
+    "Three points of the spread's lens rule on one ray about the cone's foot (core/light_spread.py, _disk_rule)")
+
+
+def _lens_points(kw):
+    """The lens rule's points [(m, weight, spread weight)] (``LENS_RAY``), padded with points of weight 0 to the
+    warped rule's count: a polar rule about the cone's foot over the light's own disk cut by the cone's circle, the
+    angles that see the disk (all, or the 2 asin(1 / d) of a foot d semi-axes outside its bounding circle), on each
+    ray the stretch inside the ellipse and within R.  The weight is linear along each ray, so this rule finds a
+    disk's overlap with the cone, a lens, exactly where the region shaded is only its fitted ellipse
+    (``spread_disk``)."""
+    foot_u, foot_v = kw["Foot U"], kw["Foot V"]
+    distance = op.sqrt(foot_u * foot_u + foot_v * foot_v)
+    ray = {name: kw[name] for name in (*_LENS_VECTORS, *_LENS_SCALARS, "Cone Scale")}
+    ray["Half Angle"] = op.select(op.greater(distance, 1.0), op.asin(op.safe_div(1.0, distance)), math.pi)
+    ray["Towards"] = op.atan2(-foot_v, -foot_u)
+    ray["Outside"] = foot_u * foot_u * kw["Inv U2"] + foot_v * foot_v * kw["Inv V2"] - 1.0
+    points = []
+    for angle, angle_weight in zip(LENS_ANGLES, LENS_ANGLE_WEIGHTS):
+        out = LENS_RAY(**ray, Node=angle, **{f"Weight {j}": angle_weight * radial_weight
+                                             for j, radial_weight in enumerate(LENS_RADIAL_WEIGHTS)})
+        points += [(out[f"M {j}"], out[f"Weight {j}"], out[f"Spread Weight {j}"]) for j in range(len(LENS_RADII))]
+    return points + [(kw["Base"], 0.0, 0.0)] * (len(QUAD_NODES) ** 2 - len(points))
+
+
+def _disk_rule(**kw):
+    """A narrow lobe's warped rule (``DISK_WARPED_AXES``) or a broad one's lens rule (``_lens_points``), point by point
+    (``DISK_POINT``), summed in order."""
+    region = {name: kw[name] for name in (*_REGION_VECTORS, *_CONE_SCALARS)}
+    axes = DISK_WARPED_AXES(A=kw["A"], B=kw["B"], E=kw["E"])
+    grid = [(i, j) for i in range(len(QUAD_NODES)) for j in range(len(QUAD_NODES))]
+    sums = {"Total": 0.0, "Weighted": 0.0}
+    for (i, j), (m, w, spread_w) in zip(grid, _lens_points(kw)):
+        square = {f"X{part}": axes[f"X {name} {i}"] for part, name in (("", "Node"), (" Weight", "Weight"),
+                                                                       (" Stretch", "Stretch"))}
+        square.update({f"Y{part}": axes[f"Y {name} {j}"] for part, name in (("", "Node"), (" Weight", "Weight"),
+                                                                            (" Stretch", "Stretch"))})
+        sums = DISK_POINT(**region, **square, Narrow=axes["Narrow"], **{"M Lens": m, "Weight Lens": w,
+                                                                       "Spread Weight Lens": spread_w}, **sums)
+    return sums
+
+
+DISK_RULE = NodeFunction(
+    "RTL Spread Disk Rule", _disk_rule,
+    _sockets({**_REGION_VECTORS, **_LENS_VECTORS}, {**_CONE_SCALARS, **_LENS_SCALARS}), _SUMS,
+    "The spread's rule on a disk: for a narrow lobe the quad's warped rule carried onto the disk, for a broad one "
+    "8 angles x 3 radii about the cone's foot over the disk's overlap with the cone (core/light_spread.py)")
+
+
+def lens_inputs(cone, position, to_lobe, inv_size):
+    """The lens rule's inputs of ``DISK_RULE`` for the light's own disk (``cone.disk``): m in the lobe's space scaled by
+    ``inv_size`` (as ``lobe_average``'s); lengths in units of the disk's larger semi-axis."""
     centre, axis_u, axis_v = cone.disk
     length_u, length_v = op.length(axis_u), op.length(axis_v)
     size = op.maximum(length_u, length_v)
     unit_u, unit_v = op.normalize(axis_u), op.normalize(axis_v)
-    inv_u2 = op.safe_div(size * size, length_u * length_u)
-    inv_v2 = op.safe_div(size * size, length_v * length_v)
     offset = cone.foot - centre
-    foot_u, foot_v = op.safe_div(op.dot(offset, unit_u), size), op.safe_div(op.dot(offset, unit_v), size)
-    reach = op.safe_div(cone.radius, size)
-    distance = op.sqrt(foot_u * foot_u + foot_v * foot_v)
-    half_angle = op.select(op.greater(distance, 1.0), op.asin(op.safe_div(1.0, distance)), math.pi)
-    towards = op.atan2(-foot_v, -foot_u)
-    base = op.scale(to_lobe(cone.foot - position), inv_size)
-    along_u, along_v = op.scale(to_lobe(unit_u), size * inv_size), op.scale(to_lobe(unit_v), size * inv_size)
-    outside = foot_u * foot_u * inv_u2 + foot_v * foot_v * inv_v2 - 1.0
-    samples = []
-    for angle, angle_weight in zip(LENS_ANGLES, LENS_ANGLE_WEIGHTS):
-        phi = towards + half_angle * angle
-        c, s = op.cos(phi), op.sin(phi)
-        # |foot + rho (c, s)| = 1 in the ellipse's metric: q2 rho^2 + q1 rho + outside = 0
-        q2 = c * c * inv_u2 + s * s * inv_v2
-        q1 = 2.0 * (foot_u * c * inv_u2 + foot_v * s * inv_v2)
-        root = op.sqrt(q1 * q1 - 4.0 * q2 * outside)
-        near = op.minimum(op.maximum(op.safe_div(-q1 - root, 2.0 * q2), 0.0), reach)
-        far = op.minimum(op.maximum(op.safe_div(-q1 + root, 2.0 * q2), near), reach)
-        half = (far - near) * 0.5
-        direction = op.scale(along_u, c) + op.scale(along_v, s)
-        for radial, radial_weight in zip(LENS_RADII, LENS_RADIAL_WEIGHTS):
-            rho = near + half + half * radial
-            samples.append((base + op.scale(direction, rho), half_angle * (angle_weight * radial_weight) * half * rho,
-                            spread_weight(rho, reach, cone.scale)))
-    return samples + [(base, 0.0, 0.0)] * (len(QUAD_NODES) ** 2 - len(samples))
+    return {"Base": op.scale(to_lobe(cone.foot - position), inv_size),
+            "Along U": op.scale(to_lobe(unit_u), size * inv_size),
+            "Along V": op.scale(to_lobe(unit_v), size * inv_size),
+            "Foot U": op.safe_div(op.dot(offset, unit_u), size), "Foot V": op.safe_div(op.dot(offset, unit_v), size),
+            "Inv U2": op.safe_div(size * size, length_u * length_u),
+            "Inv V2": op.safe_div(size * size, length_v * length_v),
+            "Reach": op.safe_div(cone.radius, size)}
 
 
 def lobe_average(cone, form, centre, axis_u, axis_v, position, to_lobe):
     """The average of the spread weight over the region ``centre + axis_u x + axis_v y`` (a quad, [-1, 1]^2, or a
     disk), weighted by the rule's weight times a lobe's kernel max(m.z, 0) / |m|^4, m = ``to_lobe``(point -
     position) (module docstring; ``to_lobe`` linear: the shading frame's coordinates, then the LTC's Minv).  The
-    quad's rule follows the lobe (``quad_points``); on a disk, a narrow lobe takes the warped rule
-    (``warped_disk_rule``), a broad one averages over the light's own overlap with the cone (``lens_samples``).  Each point's m and its
-    offset from the foot are formed as vectors (expanding their squared lengths into dot products of the three
-    vectors cancels in float32 near the foot); the three vectors in the lobe's space are normalised by their size
-    first (the average does not depend on it; a light 1e-6 m or 1e6 m away stays finite in float32)."""
+    quad's rule follows the lobe (``QUAD_RULE``); on a disk, a narrow lobe takes the warped rule
+    (``DISK_RULE``), a broad one averages over the light's own overlap with the cone (its lens rule).
+    Each point's m and its offset from the foot are formed as vectors (expanding their squared lengths into dot
+    products of the three vectors cancels in float32 near the foot); the three vectors in the lobe's space are
+    normalised by their size first (the average does not depend on it; a light 1e-6 m or 1e6 m away stays finite in
+    float32)."""
     a, b, e = to_lobe(centre - position), to_lobe(axis_u), to_lobe(axis_v)
     inv_size = op.inverse_sqrt(op.dot(a, a) + op.dot(b, b) + op.dot(e, e), 1e-30)
-    a, b, e = op.scale(a, inv_size), op.scale(b, inv_size), op.scale(e, inv_size)
-    g = centre - cone.foot
-
-    def on_region(x, y, w):
-        return a + op.scale(b, x) + op.scale(e, y), w, cone.weight(op.length(g + op.scale(axis_u, x) + op.scale(axis_v, y)))
-
+    region = {"A": op.scale(a, inv_size), "B": op.scale(b, inv_size), "E": op.scale(e, inv_size),
+              "G": centre - cone.foot, "Axis U": axis_u, "Axis V": axis_v,
+              "Cone Radius": cone.radius, "Cone Scale": cone.scale}
     if form == "quad":
-        samples = [on_region(*point) for point in quad_points(a, b, e)]
-    elif cone.disk is None:
+        rule = QUAD_RULE(**region)
+        return op.safe_div(rule["Weighted"], rule["Total"])
+    if cone.disk is None:
         raise ValueError("a disk light's spread cone must carry the light's own disk (light_spread.spread_disk)")
-    else:
-        narrow, warped = warped_disk_rule(a, b, e)
-        samples = [(op.vselect(narrow, m_warped, m_lens), op.select(narrow, w_warped, w_lens),
-                    op.select(narrow, c_warped, c_lens))
-                   for (m_warped, w_warped, c_warped), (m_lens, w_lens, c_lens)
-                   in zip([on_region(*point) for point in warped], lens_samples(cone, position, to_lobe, inv_size))]
-    total, weighted = 0.0, 0.0
-    for m, w, spread_w in samples:
-        m2 = op.maximum(op.dot(m, m), KERNEL_FLOOR)
-        kernel = op.safe_div(op.maximum(op.component(m, 2), 0.0) * w, m2 * m2)
-        total = kernel + total
-        weighted = kernel * spread_w + weighted
-    return op.safe_div(weighted, total)
+    rule = DISK_RULE(**region, **lens_inputs(cone, position, to_lobe, inv_size))
+    return op.safe_div(rule["Weighted"], rule["Total"])
 
 
 def spread_quad(position, location, half_u, half_v, spread):

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from .. import diffuse, light_spread, multiscatter, sheen
 from .. import shading_ops as op
 from ..ir.functions import NodeFunction
-from ..ir.interface import factor, vector
+from ..ir.interface import factor, scalar, vector
 from ..lut import catalog
 from . import disk, matrix, polygon
 
@@ -88,13 +88,57 @@ class QuadLight:
             return value
         corners = self.corner_list()
         axis_u, axis_v = op.scale(corners[1] - corners[0], 0.5), op.scale(corners[3] - corners[0], 0.5)
-        return value * light_spread.lobe_average(self.spread, "quad", self.center(), axis_u, axis_v, p,
-                                                 _lobe_space(c, frame))
+        return value * spread_average("quad", self.spread, self.center(), axis_u, axis_v, p, c, frame)
 
 
 def _lobe_space(c, frame):
     """The linear map from world vectors into an LTC's space: the shading frame's coordinates, then Minv."""
     return lambda d: matrix.transform_packed(c, polygon.frame_coordinates(frame, d))
+
+
+_FRAME = ("T1", "T2", "N")
+_SPREAD_DISK = ("Spread Disk Center", "Spread Disk Axis U", "Spread Disk Axis V")
+
+
+def _spread_average_function(form):
+    """``light_spread.lobe_average`` under the LTC of packed Minv c0..c3 in the frame (T1, T2, N), as one node
+    function per light form (its rules are functions of their own: core/light_spread.py)."""
+    def body(**kw):
+        disk = tuple(kw[n] for n in _SPREAD_DISK) if form == "disk" else None
+        cone = light_spread.SpreadCone(kw["Spread Foot"], kw["Spread Radius"], kw["Spread Scale"], disk)
+        to_lobe = _lobe_space(tuple(kw[f"c{i}"] for i in range(4)), tuple(kw[n] for n in _FRAME))
+        return {"Average": light_spread.lobe_average(cone, form, kw["Center"], kw["Axis U"], kw["Axis V"],
+                                                     kw["Position"], to_lobe)}
+
+    inputs = {f"c{i}": scalar(0.0, f"Packed Minv entry {i} of the lobe's LTC") for i in range(4)}
+    inputs.update({n: vector(f"The shading frame's {n} (polygon.local_frame)") for n in _FRAME})
+    inputs.update({"Position": vector("The shading point"), "Center": vector("The region's centre"),
+                   "Axis U": vector("The region's first half-axis"), "Axis V": vector("The region's second half-axis"),
+                   "Spread Foot": vector("The shading point's foot on the light's plane"),
+                   "Spread Radius": scalar(0.0, "The spread cone's radius R"),
+                   "Spread Scale": scalar(0.0, "The spread's normalisation c")})
+    if form == "disk":
+        inputs.update({n: vector(f"The disk light's own {n[12:].lower()}") for n in _SPREAD_DISK})
+    return NodeFunction(f"RTL Spread {form.capitalize()} Average", body, inputs,
+                        {"Average": scalar(0.0, "The spread's weight averaged under the lobe's kernel")},
+                        "The spread's weight averaged over a light's region under an LTC lobe's kernel "
+                        "(core/light_spread.py, lobe_average)")
+
+
+#: Form -> the node function of the spread's average under a lobe (``spread_average``).
+SPREAD_AVERAGE = {form: _spread_average_function(form) for form in ("quad", "disk")}
+
+
+def spread_average(form, cone, centre, axis_u, axis_v, p, c, frame):
+    """The spread's weight averaged over the region under the lobe of packed Minv ``c`` in ``frame``
+    (``light_spread.lobe_average``), one call of ``SPREAD_AVERAGE[form]``."""
+    args = {f"c{i}": c[i] for i in range(4)}
+    args.update(zip(_FRAME, frame))
+    args.update({"Position": p, "Center": centre, "Axis U": axis_u, "Axis V": axis_v, "Spread Foot": cone.foot,
+                 "Spread Radius": cone.radius, "Spread Scale": cone.scale})
+    if form == "disk":
+        args.update(zip(_SPREAD_DISK, cone.disk))
+    return SPREAD_AVERAGE[form](**args)["Average"]
 
 
 @dataclass(frozen=True)
@@ -124,8 +168,7 @@ class DiskLight:
         """As ``QuadLight.spread_weighted``, the average over the ellipse."""
         if self.spread is None:
             return value
-        return value * light_spread.lobe_average(self.spread, "disk", self.center, self.axis_u, self.axis_v, p,
-                                                 _lobe_space(c, frame))
+        return value * spread_average("disk", self.spread, self.center, self.axis_u, self.axis_v, p, c, frame)
 
 
 def lobe_integral(tables, prefix, light, p, n, v, roughness):
@@ -330,14 +373,29 @@ def wrapped_light(light, p, n, wrap):
                      exact_horizon=light.exact_horizon)
 
 
+def _wrapped_frame(**kw):
+    n_wrapped = diffuse.wrapped_normal(kw["N"], op.normalize(kw["To Light"]), kw["Wrap"])
+    return dict(zip(_FRAME, polygon.local_frame(n_wrapped, kw["V"])))
+
+
+WRAPPED_FRAME = NodeFunction(
+    "RTL Wrapped Frame", _wrapped_frame,
+    {"N": vector("Unit shading normal", "NONE", hide_value=True), "V": vector("Unit view direction", "NONE"),
+     "To Light": vector("The light's centre relative to the shading point", "XYZ", hide_value=True),
+     "Wrap": factor(0.0, "Wrapped-diffuse amount w")},
+    {name: vector(f"The frame's {name} about the wrapped normal", "NONE") for name in _FRAME},
+    "The shading frame (polygon.local_frame) about the normal tilted towards the light by the wrap (the talk's "
+    "WrappedNormal; core/diffuse.py)")
+
+
 def cod_wrapped_diffuse(tables, light, p, n, v, roughness, albedo, wrap):
     """Multiscattering wrapped diffuse over an area light: the CoD LTC over the light's image under the wrap (a
     light with spread: times the spread's weight averaged under the cosine about the wrapped normal, as
     ``wrapped_diffuse`` weights it; the image is another region of the plane)."""
     value = cod_diffuse(tables, wrapped_light(light, p, n, wrap), p, n, v, roughness, albedo)
     if light.spread is not None:
-        n_wrapped = diffuse.wrapped_normal(n, op.normalize(light_center(light) - p), wrap)
-        value = light.spread_weighted(value, IDENTITY, polygon.local_frame(n_wrapped, v), p)
+        frame = WRAPPED_FRAME(N=n, V=v, Wrap=wrap, **{"To Light": light_center(light) - p})
+        value = light.spread_weighted(value, IDENTITY, tuple(frame[name] for name in _FRAME), p)
     return op.select(op.greater(light_shines(light, p), 0.5), value, 0.0)
 
 

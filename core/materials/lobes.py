@@ -302,6 +302,17 @@ def _oren_nayar_punctual(tables, N, V, L, **kw):
             "Diffuse MS": rough_diffuse.multiscatter_cos(mu_l, mu_v, r)}
 
 
+FON_VIEW_ALBEDO = NodeFunction(
+    "RTL FON View Albedo",
+    lambda **kw: {"Albedo": rough_diffuse.fon_albedo(kw["Mu"], kw["Roughness"]),
+                  "One Minus Albedo": rough_diffuse.fon_one_minus_albedo(kw["Mu"], kw["Roughness"])},
+    {"Mu": scalar(0.0, "N.V"), "Roughness": factor(0.0, "Diffuse roughness sigma")},
+    {"Albedo": scalar(0.0, "E_F(mu, r): the single scattering's directional albedo"),
+     "One Minus Albedo": scalar(0.0, "1 - E_F(mu, r), without cancellation")},
+    "The directional albedo of Fujii's improved Oren-Nayar and its complement (EON; core/rough_diffuse.py): a group "
+    "of its own, so that the rough diffuse lobe under an area light with spread stays a small group")
+
+
 def _oren_nayar_area(tables, light, Position, N, V, **kw):
     r = kw["Diffuse Roughness"]
     value, _, _ = shading.lobe_integral(tables, "ltc_oren_nayar", light, Position, N, V, r)
@@ -310,8 +321,9 @@ def _oren_nayar_area(tables, light, Position, N, V, **kw):
     mu_c = op.saturate(op.dot(N, op.normalize(shading.light_center(light) - Position)))
     kernel = op.minimum(form_factor * rough_diffuse.ms_kernel_over_cosine(mu_c), 1.0)
     above = op.greater(mu_v, 0.0)
-    return {"Diffuse": op.select(above, value * rough_diffuse.fon_albedo(mu_v, r), 0.0),
-            "Diffuse MS": op.select(above, kernel * rough_diffuse.fon_one_minus_albedo(mu_v, r), 0.0)}
+    albedo = FON_VIEW_ALBEDO(Mu=mu_v, Roughness=r)
+    return {"Diffuse": op.select(above, value * albedo["Albedo"], 0.0),
+            "Diffuse MS": op.select(above, kernel * albedo["One Minus Albedo"], 0.0)}
 
 
 _OREN_NAYAR_OUT = {"Diffuse": _OUT,

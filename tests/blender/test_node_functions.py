@@ -62,7 +62,7 @@ def test_interface_has_descriptions_ranges_and_panels(empty_scene, tables):
     assert items["Metallic"].parent.name == "Surface"
 
 
-@pytest.mark.parametrize("kind", ["quad", "disk"])
+@pytest.mark.parametrize("kind", ["quad", "disk", "quad+spread", "disk+spread"])
 @pytest.mark.parametrize("lobe", sorted(LOBES))
 def test_area_lobe_groups_match_numpy(empty_scene, tables, kind, lobe):
     from rt_lookdev.addon.node_emit import MAX_GROUP_NODES, ensure_function_group, tree_node_counts

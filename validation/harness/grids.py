@@ -129,7 +129,10 @@ def sheen_roughness(rng, shape):
 
 def area_lobe_inputs(kind, seed=5, size=SIZE):
     """Shading points on the unit sphere seen from outside; lights of many sizes, tilts and
-    positions, some below the horizon, in the tangent plane, or degenerate."""
+    positions, some below the horizon, in the tangent plane, or degenerate.  ``kind`` "quad" or "disk", or either
+    with "+spread": the light's spread 0.5-180 deg (a few at 180, where it changes nothing), the geometry its data
+    function hands the lobes (``core.lights.spread_geometry``)."""
+    base, options = lights.split_kind(kind)
     rng = np.random.default_rng(seed)
     shape = (size, size)
     count = size * size
@@ -150,12 +153,18 @@ def area_lobe_inputs(kind, seed=5, size=SIZE):
     vals = {"Position": p, "N": n, "V": v, "Roughness": r, "Wrap": rng.random(count),
             "Sheen Roughness": sheen_roughness(rng, (count,))}
     vals["Diffuse Roughness"] = _diffuse_roughness(rng, count)
-    if kind == "quad":
+    if base == "quad":
         corners = [center - u - w, center + u - w, center + u + w, center - u + w]
-        vals.update({f"p{i}": c for i, c in enumerate(corners)})
-        vals["Center"] = center
+        light = {f"p{i}": c for i, c in enumerate(corners)}
+        light["Center"] = center
     else:
-        vals.update({"Center": center, "Axis U": u, "Axis V": w})
+        light = {"Center": center, "Axis U": u, "Axis V": w}
+    if "spread" in options:
+        spread = np.radians(rng.uniform(0.5, 180.0, count))
+        spread[10:14] = np.pi
+        light = dict(lights.spread_geometry(base, dict(light, Radiance=np.ones((count, 3))), p, spread))
+        light.pop("Radiance")
+    vals.update(light)
     return {k: np.asarray(a, np.float32).reshape(shape + np.shape(a)[1:]) for k, a in vals.items()}
 
 
