@@ -122,6 +122,9 @@ def test_every_readme_command_has_a_runner():
             assert f"def {function}(" in text, where
 
 
+#: Run once, in the development environment (.ci/run): each command is the README's documentation of a script, and the
+#: machinery it drives is tested on every supported release by the suite's own tests of it.
+@pytest.mark.development_release_only
 @pytest.mark.parametrize("script", sorted(SMOKE))
 def test_readme_command_runs(script, tmp_path):
     args, outputs = SMOKE[script]

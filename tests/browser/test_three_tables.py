@@ -14,6 +14,10 @@ import tempfile
 import numpy as np
 import pytest
 
+#: No bpy here: what three.js renders from the exported files does not depend on the Blender release (.ci/run runs
+#: these in the development environment only; tests/core checks the export under numpy 1 and 2).
+pytestmark = pytest.mark.development_release_only
+
 ROUGHNESS = (0.1, 0.25, 0.4, 0.6, 0.8, 1.0)
 TABLES = ("three", "rtl_f32", "rtl_f16", "three_half")
 #: The patched material (engines/three/src/patch.js): each lobe alone, at two roughness values; "single": the GGX
