@@ -48,8 +48,9 @@ median / p90 / max over 40 quads, spread 60 deg: with each lobe's kernel and the
 (30 receivers; tests/core/test_lights.py checks Lambert and r = 0.1), median / p90: Lambert 0.36% / 2.7%, r = 0.4
 0.81% / 2.6%, r = 1 0.32% / 2.6% (broad lobes: ``DISK_RULE`` over the true overlap; averaged over the overlap's
 fitted ellipse with the polar rule, before: 1.4% / 8.3%, 2.6% / 9.1%, 1.4% / 8.4%), r = 0.1 1.2% / 15% (the warped
-rule; the polar rule, before: 13% / 53%).  Cost: the warped rules add IR operations to each lobe of a light with
-spread (Turquin + CoD, one light: quad 2524 -> 3430, disk 2310 -> 6078; a light without spread is unchanged).
+rule; the polar rule, before: 13% / 53%).  Cost: the rules add IR operations to each lobe of a light with spread
+(``rt_lit.op_counts``, Turquin + CoD, one light, 2026-12-07: quad 3553, disk 6901, against 1254 and 1225 without
+spread; the warped rules' first version took a quad from 2524 to 3430 and a disk from 2310 to 6078).
 """
 from __future__ import annotations
 
