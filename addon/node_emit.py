@@ -56,7 +56,7 @@ ROW_HEIGHT = 170.0
 _COMPONENTS = {"x": 0, "y": 1, "z": 2}
 
 #: Bump when the emitter's output for an unchanged IR changes (layout aside): stamps include it.
-EMITTER_VERSION = 4
+EMITTER_VERSION = 5
 
 #: Soft cap on nodes per emitted tree (docs/blender.md, "Node groups": flat trees build
 #: super-linearly; nested groups of <= ~150 nodes build ~50x faster with identical pixels).
@@ -112,6 +112,7 @@ class _TreeWriter:
         self.rows = Counter()
         self.produced = {}
         self.separators = {}       # source vector id -> ShaderNodeSeparateXYZ
+        self.components_read = Counter(n.args[0].id for n in order if n.op in _COMPONENTS)   # vector id -> of x, y, z
         self.textures = {}         # (op, table, u id, v id) -> (Image Texture node, Separate Color node)
         self.calls = {}            # call node id -> Group node
 
@@ -192,8 +193,21 @@ def _emit_combine(w, node):
     return bn.outputs[0]
 
 
+# Why a vector read in part is not separated (measured with Cycles 4.5's shader log, GLOG_v=5): Cycles' Separate XYZ
+# compiles by giving each of its three outputs a slot on the SVM stack whether or not anything reads it
+# (``SeparateXYZNode::compile``), and the compiler frees a slot only when the last node reading it is done
+# (``SVMCompiler::stack_clear_users``), so an output nothing reads holds its slot to the end of the shader.  Those
+# slots, and the holes they leave, took the spread's quad rule from 59 to 138 of the 255 floats Blender 4.5 has, and
+# five lobes under a light with spread past them (black renders).  A component read alone is a Dot Product with its
+# axis instead: exact for finite vectors (x * 1 + y * 0 + z * 0), one node, no slot left behind.
 def _emit_component(w, node):
     src = node.args[0]
+    if w.components_read[src.id] < len(_COMPONENTS):
+        bn = w.new("ShaderNodeVectorMath", node, "component")
+        bn.operation = "DOT_PRODUCT"
+        w.feed(bn.inputs[0], src)
+        bn.inputs[1].default_value = [float(i == _COMPONENTS[node.op]) for i in range(len(_COMPONENTS))]
+        return bn.outputs["Value"]
     bn = w.separators.get(src.id)
     if bn is None:
         bn = w.separators[src.id] = w.new("ShaderNodeSeparateXYZ", node, "separate")

@@ -24,6 +24,34 @@ def test_punctual_lobe_groups_match_numpy(empty_scene, tables, lobe):
     check_function(fn, {k: vals[k] for k in fn.input_sockets}, tables)
 
 
+def _nested_trees(ng):
+    """``ng`` and every group tree nested in it, once each."""
+    trees = {ng.name: ng}
+    for tree in list(trees.values()):
+        for node in tree.nodes:
+            if node.bl_idname == "ShaderNodeGroup" and node.node_tree.name not in trees:
+                trees[node.node_tree.name] = node.node_tree
+                trees.update({t.name: t for t in _nested_trees(node.node_tree)})
+    return list(trees.values())
+
+
+@pytest.mark.parametrize("kind", ["quad+spread", "disk+spread"])
+def test_no_separate_xyz_output_is_left_unread(empty_scene, tables, kind):
+    """Cycles gives every output of a Separate XYZ a slot on its SVM stack and frees a slot only once its last reader
+    is done, so an unread output holds one for the whole shader; in Blender 4.5 such slots (the spread's rules had
+    dozens) took GGX and four other lobes under lights with spread past its 255 floats (node_emit, _emit_component).
+    A vector read in part becomes Dot Products with the axes, which the lobe tests render against numpy."""
+    from rt_lookdev.addon.node_emit import ensure_function_group
+    from rt_lookdev.core.materials import lobes
+
+    trees = _nested_trees(ensure_function_group(lobes.GGX.function(kind), tables))
+    separates = [(t.name, n) for t in trees for n in t.nodes if n.bl_idname == "ShaderNodeSeparateXYZ"]
+    unread = [(name, s.name) for name, n in separates for s in n.outputs if not s.is_linked]
+    assert not unread, unread
+    components = [n for t in trees for n in t.nodes if n.bl_idname == "ShaderNodeVectorMath" and n.label == "component"]
+    assert components and all(n.operation == "DOT_PRODUCT" for n in components)
+
+
 def test_groups_are_stamped_reused_and_rebuilt_in_place(empty_scene, tables):
     import bpy
 
@@ -62,28 +90,14 @@ def test_interface_has_descriptions_ranges_and_panels(empty_scene, tables):
     assert items["Metallic"].parent.name == "Surface"
 
 
-#: Known defect (found 2026-12-07, open): in Blender 4.5 these lobes under a light with spread render black, beyond
-#: Cycles' SVM stack (255 floats in 4.5); GGX under a quad with spread did so before its rules became node functions
-#: too (checked on 52f1c65).  5.x renders them.  The test fails if one of them starts to render, so that it leaves
-#: this list.
-SPREAD_OVERFLOW_IN_4_5 = {("cod_wrapped", "disk+spread"), ("ggx", "quad+spread"), ("ggx", "disk+spread"),
-                          ("kulla_conty", "disk+spread"), ("zeltner", "disk+spread")}
-
-
 @pytest.mark.parametrize("kind", ["quad", "disk", "quad+spread", "disk+spread"])
 @pytest.mark.parametrize("lobe", sorted(LOBES))
 def test_area_lobe_groups_match_numpy(empty_scene, tables, kind, lobe):
-    import bpy
-
     from rt_lookdev.addon.node_emit import MAX_GROUP_NODES, ensure_function_group, tree_node_counts
     from rt_lookdev.core.materials import lobes
 
     fn = lobes.LOBES[lobe].function(kind)
     vals = _area_inputs(kind)
-    if bpy.app.version < (5, 0) and (lobe, kind) in SPREAD_OVERFLOW_IN_4_5:
-        with pytest.raises(AssertionError, match="rel 1 "):          # every value 0: the stack overflowed
-            check_function(fn, {k: vals[k] for k in fn.input_sockets}, tables)
-        pytest.xfail("renders black in Blender 4.5: beyond Cycles' SVM stack (SPREAD_OVERFLOW_IN_4_5)")
     check_function(fn, {k: vals[k] for k in fn.input_sockets}, tables)
     counts = tree_node_counts(ensure_function_group(fn, tables))
     print(counts)
