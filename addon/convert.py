@@ -241,8 +241,9 @@ def _principled_input_used(material, name):
     return bool(socket.is_linked or socket.default_value > 0.0)
 
 
-#: What an exact area-light horizon costs in Blender 4.x (measured on 4.5: most feature sets overflow Cycles' SVM
-#: stack and render black; every set fits in 5.2; docs/area_lights.md, "RT Lit's exact horizon").
+#: What an exact area-light horizon costs in Blender 4.x (measured on 4.5: the largest feature set overflows Cycles'
+#: SVM stack under clipped quads and renders black; every set fits in 5.2; docs/area_lights.md, "RT Lit's exact
+#: horizon").
 EXACT_HORIZON_WARNING = ("Material '{material}': exact area-light horizons can overflow Cycles' shader stack in "
                          "Blender 4.x (the material renders black there); Blender 5 fits them, or choose the Sphere "
                          "Table horizon")

@@ -64,10 +64,10 @@ HORIZON_LABELS = {
     "sphere_table": ("Sphere Table (Talk)", "The talk's clipless form for every light: the cheapest, exact for lights "
                      "wholly above the horizon, off by several times for lights that cross it"),
     "exact_quads": ("Exact for Quads", "Quad lights clipped exactly at the surface's horizon, disk and sphere lights "
-                    "by the talk's sphere table (a quad costs about 1.8x the talk's nodes). Blender 5.x: in 4.5 most "
-                    "feature sets overflow Cycles' shader stack and render black"),
+                    "by the talk's sphere table (a quad costs about 1.8x the talk's nodes). In Blender 4.5 the largest "
+                    "feature set overflows Cycles' shader stack and renders black"),
     "exact": ("Exact", "Every area light clipped exactly at the surface's horizon: disks too, at about 2.7x the talk's "
-              "nodes per disk light. Blender 5.x: in 4.5 most feature sets overflow Cycles' shader stack"),
+              "nodes per disk light. In Blender 4.5 the largest feature set overflows Cycles' shader stack"),
 }
 HORIZON_ITEMS = tuple((m, *HORIZON_LABELS.get(m, (m.replace("_", " ").title(), ""))) for m in HORIZON_MODELS)
 

@@ -509,7 +509,7 @@ def test_switches_in_the_panel_rebuild_the_group(bpy_module, empty_scene, lut_di
 
 def test_exact_horizon_warns_in_blender_4(bpy_module, convert, factory):
     """An exact area-light horizon converts everywhere, with a warning in Blender 4.x, whose Cycles runs out of
-    shader stack for most feature sets with it (docs/area_lights.md)."""
+    shader stack with it for the largest feature set (docs/area_lights.md)."""
     from rt_lookdev.addon import compat
 
     mat = compat.new_material("Horizon")
