@@ -84,14 +84,15 @@ def _render(bpy, sc):
     return np.stack([ch["R"], ch["G"], ch["B"]], axis=-1).astype(np.float64)
 
 
-def _rt_lit_render(bpy, sc, planes):
-    """The planes with a Lambert-only RT Lit material (white), 1 sample: RT Lit's shading of the scene's lights."""
+def _rt_lit_render(bpy, sc, planes, features=None):
+    """The planes with a Lambert-only (or ``features``) RT Lit material (white), 1 sample: RT Lit's shading of the
+    scene's lights."""
     from rt_lookdev.addon import compat, materials
     from rt_lookdev.core.materials.rt_lit_interface import Features
 
     materials.sync_scene_lights(sc)
     mat = compat.new_material("RTL_rt_lit")
-    materials.assign_rt_lit(mat, Features("none", "lambert"), sc)
+    materials.assign_rt_lit(mat, features or Features("none", "lambert"), sc)
     mat.node_tree.nodes["RT Lit"].inputs["Base Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     for p in planes:
         p.data.materials[0] = mat
@@ -244,3 +245,26 @@ def test_light_setting_shades_as_cycles(bpy_module, name):
     else:
         _, median, p90_max = judge
         assert np.median(rel) <= median and p90 <= p90_max, (float(np.median(rel)), p90)
+
+
+@pytest.mark.parametrize("shape", ["SQUARE", "DISK"])
+def test_materials_beyond_lambert_render_under_spread_lights(bpy_module, shape):
+    """A Turquin + CoD material under an area light with spread renders in every supported release.  In Blender 4.5
+    it rendered black, quads and disks alike, until d793d61: the unread outputs of Separate XYZ nodes held Cycles' SVM
+    stack (addon/node_emit.py, ``_emit_component``; Cycles 4.5's log gives this material's peak as 255, "out of SVM
+    stack space", then 153 under the quad and 231 under the disk).  Judged against the Lambert material under the
+    same light: lit wherever it is, by no less (the CoD diffuse of a white rough surface is Lambert's or more, and
+    the specular adds to it) and by at most 3x."""
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    bpy = bpy_module
+    sc, planes = _scene(bpy)
+    _light(bpy, sc, "AREA", (0.2, 0.1, 0.9), DOWN, energy=40.0, shape=shape, size=1.5, spread=math.radians(40.0))
+    lambert = _rt_lit_render(bpy, sc, planes).mean(-1)
+    full = _rt_lit_render(bpy, sc, planes, Features("turquin", "cod")).mean(-1)
+    lit = lambert > 1e-3 * lambert.max()
+    ratio = full[lit] / lambert[lit]
+    print(f"\n[light model] Turquin + CoD under a {shape.lower()} with spread: {lit.sum()} lit px, ratio to Lambert "
+          f"min {ratio.min():.3f} median {np.median(ratio):.3f} max {ratio.max():.3f}")
+    assert np.isfinite(full).all() and lit.sum() > RES * RES // 8
+    assert ratio.min() >= 0.95 and ratio.max() <= 3.0
