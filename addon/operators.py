@@ -140,6 +140,29 @@ def _over_capacity(groups, lights, has_world):
             f"(docs/benchmarks/rt_lit.md); EEVEE has no such limit")
 
 
+def _black_under_spread_disks(groups, records):
+    """Blender 4.x: the warning for RT Lit groups whose switches overflow Cycles' shader stack under a disk light with
+    spread (core/materials/cycles_capacity.py, ``SPREAD_DISK_IN_4``) when the scene has one, or ""."""
+    from ..core import lights as core_lights
+    from ..core.materials import cycles_capacity
+    from ..core.materials.rt_lit_interface import Features
+    from .common import FEATURES_KEY
+
+    if bpy.app.version >= (5, 0, 0):
+        return ""
+    disks = [obj.name for obj, kind in records if core_lights.split_kind(kind)[0] == "disk"
+             and "spread" in core_lights.split_kind(kind)[1]]
+    if not disks:
+        return ""
+    labels = sorted({Features.from_dict(ng[FEATURES_KEY]).label() for ng in groups if ng.users
+                     and not cycles_capacity.renders_under_spread_disk_in_4(Features.from_dict(ng[FEATURES_KEY]))})
+    if not labels:
+        return ""
+    return (f"Blender 4.x: RT Lit materials ({'; '.join(labels)}) render black in Cycles under a disk light with "
+            f"spread ({', '.join(disks[:3])}): beyond its shader stack; Blender 5 renders them, as does EEVEE, or "
+            "choose fewer switches (docs/area_lights.md)")
+
+
 class RTL_OT_sync_lights(bpy.types.Operator):
     """Rebuild the RT Lit groups for the lights now in the scene (after adding, removing or
     changing the shape of a light; moving or editing a light needs no sync: drivers follow it)"""
@@ -165,7 +188,8 @@ class RTL_OT_sync_lights(bpy.types.Operator):
         ignored = _ignored_settings(records)
         if ignored:
             message += f"; not shaded: {ignored}"
-        over = _over_capacity(groups, len(records), WORLD_GROUP in bpy.data.node_groups)
+        over = ". ".join(w for w in (_over_capacity(groups, len(records), WORLD_GROUP in bpy.data.node_groups),
+                                     _black_under_spread_disks(groups, records)) if w)
         if over:
             self.report({'WARNING'}, f"{message}. {over}")
         else:

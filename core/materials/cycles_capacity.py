@@ -58,6 +58,28 @@ def light_capacity(features, world=False):
     return (max(bounds) if bounds else min(caps[column] for caps in MEASURED.values())), False
 
 
+#: Blender 4.x only (Cycles 4.5): whether a material with these switches renders under one disk light with spread, or
+#: runs out of SVM stack and renders black.  Measured 2026-12-07 on the plane of tests/blender/test_light_model.py
+#: under a 1.5 m disk with a 40-degree spread, peaks from Cycles 4.5's log (GLOG_v=5) of its 255 floats: Lambert 151,
+#: Turquin + CoD 231, Kulla-Conty + Lambert 234, every switch on out of stack.  Quads with spread fit every set
+#: (99-235), and Blender 5.x renders them all.
+SPREAD_DISK_IN_4 = {
+    Features("none", "lambert"): True,
+    Features("turquin", "cod"): True,
+    Features("kulla_conty", "lambert"): True,
+    Features("kulla_conty", "wrapped", sheen=True, cloth=True): False,
+}
+
+
+def renders_under_spread_disk_in_4(features):
+    """Whether Blender 4.x renders a material with ``features`` under a disk light with spread
+    (``SPREAD_DISK_IN_4``); an unmeasured set does where a measured set at least as costly does."""
+    key = Features(features.specular, features.diffuse, features.sheen, features.cloth)
+    if key in SPREAD_DISK_IN_4:
+        return SPREAD_DISK_IN_4[key]
+    return any(ok and _at_least_as_costly(measured, key) for measured, ok in SPREAD_DISK_IN_4.items())
+
+
 def is_lower_bound(capacity):
     """True when ``capacity`` is where the benchmark's search stopped, not where the material failed."""
     return capacity >= SEARCHED_UP_TO

@@ -269,6 +269,34 @@ def test_sync_lights_names_what_is_not_shaded_and_the_capacity_of_each_feature_s
     assert "(single, lambert)" not in out.split("capacity")[-1]       # 4 lights are within its 15
 
 
+def test_sync_lights_warns_in_blender_4_of_materials_black_under_spread_disks(registered, empty_scene, lut_dir, capfd):
+    """Blender 4.x: Sync Lights names the materials whose switches overflow Cycles' shader stack under a disk light
+    with spread (measured: core/materials/cycles_capacity.py, SPREAD_DISK_IN_4), and not those that fit; 5.x, which
+    renders them all, says nothing of it."""
+    import math
+
+    from rt_lookdev.core.materials.rt_lit_interface import Features
+
+    bpy = registered
+    scene = empty_scene
+    _rt_lit_object(bpy, scene, lut_dir, Features("kulla_conty", "wrapped", sheen=True, cloth=True))
+    _rt_lit_object(bpy, scene, lut_dir, Features("turquin", "cod"))
+    panel = bpy.data.objects.new("Panel", bpy.data.lights.new("Panel", "AREA"))
+    panel.data.shape = "DISK"
+    scene.collection.objects.link(panel)
+    assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
+    assert "disk light with spread" not in _reports(capfd)           # no spread (180 deg): every set renders
+    panel.data.spread = math.radians(40.0)
+    assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
+    out = _reports(capfd)
+    if bpy.app.version < (5, 0, 0):
+        warning = out.split("Blender 4.x: RT Lit materials (")[1]
+        assert warning.startswith("kulla-conty, wrapped, sheen, cloth) render black in Cycles under a disk light "
+                                  "with spread (Panel)")
+    else:
+        assert "disk light with spread" not in out
+
+
 def test_lights_stay_in_sync_without_a_button(registered, empty_scene, lut_dir):
     """With the add-on enabled, adding, hiding, excluding, removing a light or changing an area light's shape
     re-syncs RT Lit at the next depsgraph update; moving a light changes nothing to sync."""

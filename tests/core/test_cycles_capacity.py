@@ -54,3 +54,14 @@ def test_every_model_of_every_switch_gets_a_capacity():
 def test_a_capacity_at_the_searchs_cap_is_a_lower_bound():
     assert cycles_capacity.is_lower_bound(cycles_capacity.SEARCHED_UP_TO)
     assert not cycles_capacity.is_lower_bound(cycles_capacity.SEARCHED_UP_TO - 1)
+
+
+def test_blender_4_spread_disk_table_bounds_unmeasured_sets():
+    """Blender 4.x under a disk light with spread: the measured sets as measured; an unmeasured set renders where a
+    measured one at least as costly does, and is warned about otherwise (the warning errs on the safe side)."""
+    fits = cycles_capacity.renders_under_spread_disk_in_4
+    assert fits(Features("turquin", "cod")) and not fits(Features("kulla_conty", "wrapped", sheen=True, cloth=True))
+    assert fits(Features("single", "lambert"))                  # bounded by Turquin + CoD (and Kulla-Conty + Lambert)
+    assert fits(Features("fdez_aguera", "cod"))                 # Turquin + CoD: specular and diffuse as costly
+    assert not fits(Features("turquin", "cod", sheen=True))     # no measured set with a sheen renders
+    assert not fits(Features("kulla_conty", "cod"))             # neither measured set bounds both switches
