@@ -5,7 +5,7 @@
 GATES = {
     ('cloth', 'disk'): (0.012, 0.14),
     ('cloth', 'point'): (1e-05, 1e-05),
-    ('cloth', 'quad'): (0.013, 0.16),
+    ('cloth', 'quad'): (0.015, 0.27),
     ('cloth', 'sphere'): (0.012, 0.16),
     ('cloth', 'spot'): (1e-05, 1e-05),
     ('cloth', 'sun'): (1e-05, 1e-05),
