@@ -140,9 +140,9 @@ def _over_capacity(groups, lights, has_world):
             f"(docs/benchmarks/rt_lit.md); EEVEE has no such limit")
 
 
-def _black_under_spread_disks(groups, records):
-    """Blender 4.x: the warning for RT Lit groups whose switches overflow Cycles' shader stack under a disk light with
-    spread (core/materials/cycles_capacity.py, ``SPREAD_DISK_IN_4``) when the scene has one, or ""."""
+def _black_under_spread_lights(groups, records):
+    """Blender 4.x: the warning for RT Lit groups whose switches overflow Cycles' shader stack under an area light with
+    spread (core/materials/cycles_capacity.py, ``SPREAD_IN_4``) when the scene has one, or ""."""
     from ..core import lights as core_lights
     from ..core.materials import cycles_capacity
     from ..core.materials.rt_lit_interface import Features
@@ -150,17 +150,20 @@ def _black_under_spread_disks(groups, records):
 
     if bpy.app.version >= (5, 0, 0):
         return ""
-    disks = [obj.name for obj, kind in records if core_lights.split_kind(kind)[0] == "disk"
-             and "spread" in core_lights.split_kind(kind)[1]]
-    if not disks:
+    spread = {}                              # light form -> names of its lights with spread
+    for obj, kind in records:
+        base, options = core_lights.split_kind(kind)
+        if "spread" in options and base in cycles_capacity.SPREAD_IN_4:
+            spread.setdefault(base, []).append(obj.name)
+    black = {Features.from_dict(ng[FEATURES_KEY]).label(): None for ng in groups if ng.users
+             and any(not cycles_capacity.renders_under_spread_in_4(form, Features.from_dict(ng[FEATURES_KEY]))
+                     for form in spread)}
+    if not black:
         return ""
-    labels = sorted({Features.from_dict(ng[FEATURES_KEY]).label() for ng in groups if ng.users
-                     and not cycles_capacity.renders_under_spread_disk_in_4(Features.from_dict(ng[FEATURES_KEY]))})
-    if not labels:
-        return ""
-    return (f"Blender 4.x: RT Lit materials ({'; '.join(labels)}) render black in Cycles under a disk light with "
-            f"spread ({', '.join(disks[:3])}): beyond its shader stack; Blender 5 renders them, as does EEVEE, or "
-            "choose fewer switches (docs/area_lights.md)")
+    lights = [name for names in spread.values() for name in names]
+    return (f"Blender 4.x: RT Lit materials ({'; '.join(sorted(black))}) render black in Cycles under an area light "
+            f"with spread ({', '.join(lights[:3])}): beyond its shader stack; Blender 5 renders them, as does EEVEE, "
+            "or choose fewer switches (core/materials/cycles_capacity.py)")
 
 
 class RTL_OT_sync_lights(bpy.types.Operator):
@@ -189,7 +192,7 @@ class RTL_OT_sync_lights(bpy.types.Operator):
         if ignored:
             message += f"; not shaded: {ignored}"
         over = ". ".join(w for w in (_over_capacity(groups, len(records), WORLD_GROUP in bpy.data.node_groups),
-                                     _black_under_spread_disks(groups, records)) if w)
+                                     _black_under_spread_lights(groups, records)) if w)
         if over:
             self.report({'WARNING'}, f"{message}. {over}")
         else:

@@ -269,9 +269,10 @@ def test_sync_lights_names_what_is_not_shaded_and_the_capacity_of_each_feature_s
     assert "(single, lambert)" not in out.split("capacity")[-1]       # 4 lights are within its 15
 
 
-def test_sync_lights_warns_in_blender_4_of_materials_black_under_spread_disks(registered, empty_scene, lut_dir, capfd):
-    """Blender 4.x: Sync Lights names the materials whose switches overflow Cycles' shader stack under a disk light
-    with spread (measured: core/materials/cycles_capacity.py, SPREAD_DISK_IN_4), and not those that fit; 5.x, which
+def test_sync_lights_warns_in_blender_4_of_materials_black_under_spread_lights(registered, empty_scene, lut_dir,
+                                                                               capfd):
+    """Blender 4.x: Sync Lights names the materials whose switches overflow Cycles' shader stack under an area light
+    with spread (measured: core/materials/cycles_capacity.py, SPREAD_IN_4), and not those that fit; 5.x, which
     renders them all, says nothing of it."""
     import math
 
@@ -285,16 +286,16 @@ def test_sync_lights_warns_in_blender_4_of_materials_black_under_spread_disks(re
     panel.data.shape = "DISK"
     scene.collection.objects.link(panel)
     assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
-    assert "disk light with spread" not in _reports(capfd)           # no spread (180 deg): every set renders
+    assert "light with spread" not in _reports(capfd)                # no spread (180 deg): every set renders
     panel.data.spread = math.radians(40.0)
     assert bpy.ops.rtl.sync_lights() == {'FINISHED'}
     out = _reports(capfd)
     if bpy.app.version < (5, 0, 0):
         warning = out.split("Blender 4.x: RT Lit materials (")[1]
-        assert warning.startswith("kulla-conty, wrapped, sheen, cloth) render black in Cycles under a disk light "
+        assert warning.startswith("kulla-conty, wrapped, sheen, cloth) render black in Cycles under an area light "
                                   "with spread (Panel)")
     else:
-        assert "disk light with spread" not in out
+        assert "light with spread" not in out
 
 
 def test_lights_stay_in_sync_without_a_button(registered, empty_scene, lut_dir):

@@ -1,4 +1,5 @@
 """The Cycles light capacities the add-on warns with are the measured ones (docs/benchmarks/rt_lit.json)."""
+import functools
 import json
 from pathlib import Path
 
@@ -56,12 +57,14 @@ def test_a_capacity_at_the_searchs_cap_is_a_lower_bound():
     assert not cycles_capacity.is_lower_bound(cycles_capacity.SEARCHED_UP_TO - 1)
 
 
-def test_blender_4_spread_disk_table_bounds_unmeasured_sets():
-    """Blender 4.x under a disk light with spread: the measured sets as measured; an unmeasured set renders where a
+def test_blender_4_spread_table_bounds_unmeasured_sets():
+    """Blender 4.x under an area light with spread: the measured sets as measured; an unmeasured set renders where a
     measured one at least as costly does, and is warned about otherwise (the warning errs on the safe side)."""
-    fits = cycles_capacity.renders_under_spread_disk_in_4
-    assert fits(Features("turquin", "cod")) and not fits(Features("kulla_conty", "wrapped", sheen=True, cloth=True))
-    assert fits(Features("single", "lambert"))                  # bounded by Turquin + CoD (and Kulla-Conty + Lambert)
-    assert fits(Features("fdez_aguera", "cod"))                 # Turquin + CoD: specular and diffuse as costly
-    assert not fits(Features("turquin", "cod", sheen=True))     # no measured set with a sheen renders
-    assert not fits(Features("kulla_conty", "cod"))             # neither measured set bounds both switches
+    for form in ("quad", "disk"):
+        fits = functools.partial(cycles_capacity.renders_under_spread_in_4, form)
+        assert fits(Features("turquin", "cod")) and not fits(Features("kulla_conty", "wrapped", sheen=True, cloth=True))
+        assert fits(Features("single", "lambert"))               # bounded by Turquin + CoD (and Kulla-Conty + Lambert)
+        assert fits(Features("fdez_aguera", "cod"))              # Turquin + CoD: specular and diffuse as costly
+        assert fits(Features("turquin", "cod", sheen="disney_fitted"))    # Turquin + CoD + Zeltner's sheen
+        assert not fits(Features("turquin", "cod", cloth=True))  # no measured set with cloth is as costly
+        assert not fits(Features("kulla_conty", "cod"))          # neither measured set bounds both switches
