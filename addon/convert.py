@@ -242,11 +242,19 @@ def _principled_input_used(material, name):
 
 
 #: What an exact area-light horizon costs in Blender 4.x (measured on 4.5: the largest feature set overflows Cycles'
-#: SVM stack under clipped quads and renders black; every set fits in 5.2; docs/area_lights.md, "RT Lit's exact
-#: horizon").
-EXACT_HORIZON_WARNING = ("Material '{material}': exact area-light horizons can overflow Cycles' shader stack in "
-                         "Blender 4.x (the material renders black there); Blender 5 fits them, or choose the Sphere "
-                         "Table horizon")
+#: SVM stack under clipped quads and renders black, the others measured fit: core/materials/cycles_capacity.py,
+#: EXACT_HORIZON_IN_4; every set fits in 5.2; docs/area_lights.md, "RT Lit's exact horizon").
+def exact_horizon_renders(features):
+    """Whether Cycles renders a material with ``features`` and an exact horizon in this Blender: every set in 5.x, the
+    measured ones (and those a costlier measured set bounds) in 4.x."""
+    from ..core.materials import cycles_capacity
+
+    return bpy.app.version >= (5, 0, 0) or cycles_capacity.renders_with_exact_horizon_in_4(features)
+
+
+EXACT_HORIZON_WARNING = ("Material '{material}': with these switches an exact area-light horizon overflows Cycles' "
+                         "shader stack in Blender 4.x (the material renders black there); Blender 5 fits it, or choose "
+                         "fewer switches or the Sphere Table horizon")
 
 
 def stored_features(material):
@@ -450,7 +458,7 @@ def principled_to_rt_lit(material, group_factory, features=None):
         amount = "a linked Diffuse Roughness" if rough.is_linked else f"Diffuse Roughness {rough.default_value:.3g}"
         result.warnings.append(f"Material '{material.name}': {amount} is not shaded by the '{features.diffuse}' "
                                "diffuse; convert again with the Oren-Nayar diffuse to keep it")
-    if features.horizon != "sphere_table" and bpy.app.version < (5, 0, 0):
+    if features.horizon != "sphere_table" and not exact_horizon_renders(features):
         result.warnings.append(EXACT_HORIZON_WARNING.format(material=material.name))
     if ignored:
         result.warnings.append(

@@ -85,8 +85,9 @@ def draw_switches(layout, owner):
     layout.prop(owner, "cloth")
     layout.prop(owner, "occlusion")
     layout.prop(owner, "horizon")
-    if owner.horizon != "sphere_table" and bpy.app.version < (5, 0, 0):
-        layout.label(text="Blender 4.x: may render black (shader stack)", icon='ERROR')
+    if owner.horizon != "sphere_table" and not convert.exact_horizon_renders(
+            Features(owner.specular, owner.diffuse, sheen=owner.sheen, cloth=owner.cloth)):
+        layout.label(text="Blender 4.x: renders black with these switches (shader stack)", icon='ERROR')
 
 
 # --------------------------------------------------------------------------------------------

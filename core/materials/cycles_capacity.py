@@ -71,14 +71,37 @@ SPREAD_IN_4 = {form: {**dict.fromkeys(_FITS_UNDER_SPREAD_IN_4, True),
                       Features("kulla_conty", "wrapped", sheen=True, cloth=True): False} for form in ("quad", "disk")}
 
 
-def renders_under_spread_in_4(form, features):
-    """Whether Blender 4.x renders a material with ``features`` under a ``form`` ("quad", "disk") area light with
-    spread (``SPREAD_IN_4``); an unmeasured set does where a measured set at least as costly does."""
-    table = SPREAD_IN_4[form]
+def _renders(table, features):
+    """``table`` (measured switches -> renders) for ``features``; an unmeasured set renders where a measured set at
+    least as costly renders."""
     key = Features(features.specular, features.diffuse, features.sheen, features.cloth)
     if key in table:
         return table[key]
     return any(ok and _at_least_as_costly(measured, key) for measured, ok in table.items())
+
+
+def renders_under_spread_in_4(form, features):
+    """Whether Blender 4.x renders a material with ``features`` under a ``form`` ("quad", "disk") area light with
+    spread (``SPREAD_IN_4``)."""
+    return _renders(SPREAD_IN_4[form], features)
+
+
+#: Blender 4.x only: whether a material with these switches renders once its lobes clip quad lights exactly at the
+#: horizon (Features.horizon "exact_quads" or "exact"; issue 30), measured as ``SPREAD_IN_4`` (a plane under one
+#: 1.5 m light, no spread, 2026-12-07): under a quad 102-180 floats for eight sets, every switch on out of stack; under
+#: an exact disk all nine sets fit (64-141), so the quads decide.  Blender 5.x renders every set.
+EXACT_HORIZON_IN_4 = {
+    **dict.fromkeys((Features("turquin", "cod"), Features("none", "cod", sheen=True, cloth=True),
+                     Features("fdez_aguera", "cod_wrapped"), Features("turquin", "oren_nayar"),
+                     Features("turquin", "cod", sheen="zeltner"), Features("single", "lambert", sheen="disney_fitted"),
+                     Features("single", "lambert"), Features("kulla_conty", "lambert")), True),
+    Features("kulla_conty", "wrapped", sheen=True, cloth=True): False,
+}
+
+
+def renders_with_exact_horizon_in_4(features):
+    """Whether Blender 4.x renders a material with ``features`` and an exact horizon (``EXACT_HORIZON_IN_4``)."""
+    return _renders(EXACT_HORIZON_IN_4, features)
 
 
 def is_lower_bound(capacity):

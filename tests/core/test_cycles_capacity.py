@@ -68,3 +68,13 @@ def test_blender_4_spread_table_bounds_unmeasured_sets():
         assert fits(Features("turquin", "cod", sheen="disney_fitted"))    # Turquin + CoD + Zeltner's sheen
         assert not fits(Features("turquin", "cod", cloth=True))  # no measured set with cloth is as costly
         assert not fits(Features("kulla_conty", "cod"))          # neither measured set bounds both switches
+
+
+def test_blender_4_exact_horizon_table():
+    """Blender 4.x with an exact horizon: every switch on is warned about, the measured sets that fit are not, nor a
+    set a costlier measured one bounds; the horizon itself plays no part in the lookup."""
+    fits = cycles_capacity.renders_with_exact_horizon_in_4
+    assert not fits(Features("kulla_conty", "wrapped", sheen=True, cloth=True, horizon="exact"))
+    assert fits(Features("turquin", "cod", horizon="exact_quads")) and fits(Features("kulla_conty", "lambert"))
+    assert fits(Features("fdez_aguera", "wrapped"))             # Fernandez-Aguera + CoD wrapped bounds it
+    assert not fits(Features("kulla_conty", "wrapped"))         # no measured set bounds Kulla-Conty with a wrap
