@@ -819,9 +819,9 @@ SPREAD_OUTPUTS = {
 
 
 #: A disk light with spread also hands its lobes its own ellipse, over whose overlap with the cone broad lobes average
-#: the weight (``light_spread.DISK_LENS_RULE``; the region it shades is an ellipse fitted to that overlap).
+#: the weight (``light_spread.DISK_RULE``; the region it shades is an ellipse fitted to that overlap).
 SPREAD_DISK_OUTPUTS = {
-    "Spread Disk Center": vector("The disk light's own centre (core/light_spread.py, DISK_LENS_RULE)", "XYZ"),
+    "Spread Disk Center": vector("The disk light's own centre (core/light_spread.py, DISK_RULE)", "XYZ"),
     "Spread Disk Axis U": vector("The disk light's own first semi-axis", "XYZ"),
     "Spread Disk Axis V": vector("The disk light's own second semi-axis", "XYZ"),
 }

@@ -47,7 +47,8 @@ OCCLUSION_MODELS = ("none", "lagarde", "cones", "cones_clipped")
 #: (docs/benchmarks/horizon.md): clipping takes GGX under quads crossing the horizon from 17% to 3.5% p90 and Lambert
 #: to float precision, for ~1.8x a quad light's nodes; disks (Lambert to 5e-7) for ~2.7x theirs.  The default stays
 #: the talk's form: cheapest, and in Blender 4.5 the largest feature set's clipped quads overflow Cycles' SVM stack
-#: (black renders; the other measured sets fit, all fit in 5.2: docs/area_lights.md).  The Zeltner sheen clips under all three.
+#: (black renders; the other measured sets fit, all fit in 5.2: docs/area_lights.md).  The Zeltner sheen clips under
+#: all three.
 HORIZON_MODELS = ("sphere_table", "exact_quads", "exact")
 #: The model an artist gets when switching world occlusion on (the Convert dialog, New Lookdev Scene).
 DEFAULT_OCCLUSION = "cones_clipped"
