@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import bpy
 
+from ..core.materials import cycles_capacity
 from ..core.materials.principled_mapping import (LINK_ONLY_INPUTS, MAPPED_INPUTS, RT_LIT_ONLY_INPUTS, converted_value,
                                                 values_equal)
 from ..core.materials.rt_lit_interface import PRINCIPLED_SHEEN, Features
@@ -241,17 +242,15 @@ def _principled_input_used(material, name):
     return bool(socket.is_linked or socket.default_value > 0.0)
 
 
-#: What an exact area-light horizon costs in Blender 4.x (measured on 4.5: the largest feature set overflows Cycles'
-#: SVM stack under clipped quads and renders black, the others measured fit: core/materials/cycles_capacity.py,
-#: EXACT_HORIZON_IN_4; every set fits in 5.2; docs/area_lights.md, "RT Lit's exact horizon").
 def exact_horizon_renders(features):
     """Whether Cycles renders a material with ``features`` and an exact horizon in this Blender: every set in 5.x, the
     measured ones (and those a costlier measured set bounds) in 4.x."""
-    from ..core.materials import cycles_capacity
-
     return bpy.app.version >= (5, 0, 0) or cycles_capacity.renders_with_exact_horizon_in_4(features)
 
 
+#: What an exact area-light horizon costs in Blender 4.x (measured on 4.5: the largest feature set overflows Cycles'
+#: SVM stack under clipped quads and renders black, the others measured fit: core/materials/cycles_capacity.py,
+#: EXACT_HORIZON_IN_4; every set fits in 5.2; docs/area_lights.md, "RT Lit's exact horizon").
 EXACT_HORIZON_WARNING = ("Material '{material}': with these switches an exact area-light horizon overflows Cycles' "
                          "shader stack in Blender 4.x (the material renders black there); Blender 5 fits it, or choose "
                          "fewer switches or the Sphere Table horizon")

@@ -150,20 +150,16 @@ def _black_under_spread_lights(groups, records):
 
     if bpy.app.version >= (5, 0, 0):
         return ""
-    spread = {}                              # light form -> names of its lights with spread
-    for obj, kind in records:
-        base, options = core_lights.split_kind(kind)
-        if "spread" in options and base in cycles_capacity.SPREAD_IN_4:
-            spread.setdefault(base, []).append(obj.name)
-    black = {Features.from_dict(ng[FEATURES_KEY]).label(): None for ng in groups if ng.users
-             and any(not cycles_capacity.renders_under_spread_in_4(form, Features.from_dict(ng[FEATURES_KEY]))
-                     for form in spread)}
+    spread = [obj.name for obj, kind in records if "spread" in core_lights.split_kind(kind)[1]]
+    if not spread:
+        return ""
+    black = sorted({features.label() for features in (Features.from_dict(ng[FEATURES_KEY]) for ng in groups if ng.users)
+                    if not cycles_capacity.renders_under_spread_in_4(features)})
     if not black:
         return ""
-    lights = [name for names in spread.values() for name in names]
-    return (f"Blender 4.x: RT Lit materials ({'; '.join(sorted(black))}) render black in Cycles under an area light "
-            f"with spread ({', '.join(lights[:3])}): beyond its shader stack; Blender 5 renders them, as does EEVEE, "
-            "or choose fewer switches (core/materials/cycles_capacity.py)")
+    return (f"Blender 4.x: RT Lit materials ({'; '.join(black)}) render black in Cycles under an area light with spread "
+            f"({', '.join(spread[:3])}): beyond its shader stack; Blender 5 renders them, as does EEVEE, or choose "
+            "fewer switches (core/materials/cycles_capacity.py)")
 
 
 class RTL_OT_sync_lights(bpy.types.Operator):

@@ -58,17 +58,17 @@ def light_capacity(features, world=False):
     return (max(bounds) if bounds else min(caps[column] for caps in MEASURED.values())), False
 
 
-#: Blender 4.x only (Cycles 4.5): whether a material with these switches renders under one area light with spread (its
-#: form: quad or disk), or runs out of SVM stack and renders black.  Measured 2026-12-07 on the plane of
-#: tests/blender/test_light_model.py under a 1.5 m light with a 40-degree spread, Sheen and Cloth Weight 0.5 (at 0
+#: Blender 4.x only (Cycles 4.5): whether a material with these switches renders under an area light with spread, or
+#: runs out of SVM stack and renders black; quads and disks gave the same verdicts.  Measured 2026-12-07 on the plane of
+#: tests/blender/test_light_model.py under one 1.5 m light with a 40-degree spread, Sheen and Cloth Weight 0.5 (at 0
 #: Cycles folds those lobes away), peaks from Cycles 4.5's log (GLOG_v=5) of its 255 floats, quad / disk: Lambert
 #: 99 / 151, Lambert + cloth 145 / 208, Turquin + CoD 153 / 231, Turquin + CoD + Zeltner sheen 161 / 236,
 #: Kulla-Conty + Lambert 159 / 234, every switch on out of stack under both.  Blender 5.x renders every set.
-_FITS_UNDER_SPREAD_IN_4 = (Features("none", "lambert"), Features("none", "lambert", cloth=True),
-                           Features("turquin", "cod"), Features("turquin", "cod", sheen="zeltner"),
-                           Features("kulla_conty", "lambert"))
-SPREAD_IN_4 = {form: {**dict.fromkeys(_FITS_UNDER_SPREAD_IN_4, True),
-                      Features("kulla_conty", "wrapped", sheen=True, cloth=True): False} for form in ("quad", "disk")}
+SPREAD_IN_4 = {
+    **dict.fromkeys((Features("none", "lambert"), Features("none", "lambert", cloth=True), Features("turquin", "cod"),
+                     Features("turquin", "cod", sheen="zeltner"), Features("kulla_conty", "lambert")), True),
+    Features("kulla_conty", "wrapped", sheen=True, cloth=True): False,
+}
 
 
 def _renders(table, features):
@@ -80,10 +80,9 @@ def _renders(table, features):
     return any(ok and _at_least_as_costly(measured, key) for measured, ok in table.items())
 
 
-def renders_under_spread_in_4(form, features):
-    """Whether Blender 4.x renders a material with ``features`` under a ``form`` ("quad", "disk") area light with
-    spread (``SPREAD_IN_4``)."""
-    return _renders(SPREAD_IN_4[form], features)
+def renders_under_spread_in_4(features):
+    """Whether Blender 4.x renders a material with ``features`` under an area light with spread (``SPREAD_IN_4``)."""
+    return _renders(SPREAD_IN_4, features)
 
 
 #: Blender 4.x only: whether a material with these switches renders once its lobes clip quad lights exactly at the

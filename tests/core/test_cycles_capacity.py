@@ -1,5 +1,4 @@
 """The Cycles light capacities the add-on warns with are the measured ones (docs/benchmarks/rt_lit.json)."""
-import functools
 import json
 from pathlib import Path
 
@@ -60,14 +59,13 @@ def test_a_capacity_at_the_searchs_cap_is_a_lower_bound():
 def test_blender_4_spread_table_bounds_unmeasured_sets():
     """Blender 4.x under an area light with spread: the measured sets as measured; an unmeasured set renders where a
     measured one at least as costly does, and is warned about otherwise (the warning errs on the safe side)."""
-    for form in ("quad", "disk"):
-        fits = functools.partial(cycles_capacity.renders_under_spread_in_4, form)
-        assert fits(Features("turquin", "cod")) and not fits(Features("kulla_conty", "wrapped", sheen=True, cloth=True))
-        assert fits(Features("single", "lambert"))               # bounded by Turquin + CoD (and Kulla-Conty + Lambert)
-        assert fits(Features("fdez_aguera", "cod"))              # Turquin + CoD: specular and diffuse as costly
-        assert fits(Features("turquin", "cod", sheen="disney_fitted"))    # Turquin + CoD + Zeltner's sheen
-        assert not fits(Features("turquin", "cod", cloth=True))  # no measured set with cloth is as costly
-        assert not fits(Features("kulla_conty", "cod"))          # neither measured set bounds both switches
+    fits = cycles_capacity.renders_under_spread_in_4
+    assert fits(Features("turquin", "cod")) and not fits(Features("kulla_conty", "wrapped", sheen=True, cloth=True))
+    assert fits(Features("single", "lambert"))                  # bounded by Turquin + CoD (and Kulla-Conty + Lambert)
+    assert fits(Features("fdez_aguera", "cod"))                 # Turquin + CoD: specular and diffuse as costly
+    assert fits(Features("turquin", "cod", sheen="disney_fitted"))    # Turquin + CoD + Zeltner's sheen
+    assert not fits(Features("turquin", "cod", cloth=True))     # no measured set with cloth is as costly
+    assert not fits(Features("kulla_conty", "cod"))             # neither measured set bounds both switches
 
 
 def test_blender_4_exact_horizon_table():
