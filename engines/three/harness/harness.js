@@ -119,6 +119,9 @@ async function render( spec ) {
 	const rtlTables = spec.patched ? await loadRtLitTables( spec.rtlUrl, { EXRLoader } ) : null;
 	const plane = new THREE.PlaneGeometry( PLANE_SIDE, PLANE_SIDE );
 	const results = [];
+	// Materials are disposed at the end, not after their draw: disposing the last user of a program deletes it, and
+	// SwiftShader then compiles the same program again for the next material (seconds per draw).
+	const drawn = [];
 	for ( const config of spec.configs ) {
 
 		const camera = makeCamera( config.camera );
@@ -142,9 +145,9 @@ async function render( spec ) {
 
 				// a new material per draw: its uniforms pick up the installed tables when it is first compiled
 				mesh.material = new THREE.MeshStandardMaterial( { color: 0xffffff, metalness: 1, roughness: r } );
+				drawn.push( mesh.material );
 				renderer.render( scene, camera );
 				out.values[ name ].push( toBase64( channel( readTarget( renderer, target, size ), 0 ) ) );
-				mesh.material.dispose();
 
 			}
 
@@ -157,9 +160,9 @@ async function render( spec ) {
 			const material = new THREE.MeshPhysicalMaterial( variant.params );
 			if ( variant.patch ) patchAreaLights( material, { tables: rtlTables, ...variant.patch } );
 			mesh.material = material;
+			drawn.push( material );
 			renderer.render( scene, camera );
 			out.patched[ variant.name ] = toBase64( channel( readTarget( renderer, target, size ), 0 ) );
-			material.dispose();
 
 		}
 
@@ -169,6 +172,7 @@ async function render( spec ) {
 	}
 
 	renderer.setRenderTarget( null );
+	for ( const material of drawn ) material.dispose();
 	renderer.dispose();
 	return { info, results };
 
