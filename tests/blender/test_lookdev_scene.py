@@ -87,11 +87,11 @@ def test_twin_operator_refuses_a_scene_without_rt_lit(registered, empty_scene):
 
 def test_rt_lit_against_the_path_traced_twin(lookdev):
     """The acceptance measurement at a test's size: RT Lit within the gates of the main job's comparison
-    of the path-traced twin (and EEVEE within its half-precision film of Cycles, where EEVEE renders)."""
+    of the path-traced twin (EEVEE's render of the same scene: the next test)."""
     from rt_lookdev.validation.checks import lookdev_twin
 
     _, scene, twin = lookdev
-    result = lookdev_twin.compare(scene, twin, resolution=(200, 100), samples=64, eevee=True, log=print)
+    result = lookdev_twin.compare(scene, twin, resolution=(200, 100), samples=64, eevee=False, log=print)
     print(lookdev_twin.format_markdown(result))
     checks = lookdev_twin.checks(result)
     assert all(checks.values()), checks
@@ -103,3 +103,20 @@ def test_rt_lit_against_the_path_traced_twin(lookdev):
     assert 0.0 <= result["shadowed_fraction"] < 0.10
     images = result["images"]
     assert np.isfinite(images["rt_lit"]).all() and images["rt_lit"].max() > 0.05
+
+
+@pytest.mark.development_release_only
+def test_eevee_renders_the_lookdev_scene_as_cycles(lookdev, tmp_path):
+    """EEVEE's render of the lookdev scene within its half-precision film of Cycles' RT Lit render (the main job's
+    gate, ``lookdev_twin.EEVEE_MEDIAN_MAX``).  In the development release only: Blender 4.5's EEVEE compiles these
+    materials for 91 s on llvmpipe, and test_engine_trees and test_shadows render RT Lit in EEVEE there."""
+    from rt_lookdev.validation.checks import lookdev_twin
+
+    _, scene, twin = lookdev
+    resolution = (200, 100)
+    lookdev_twin.number_objects(scene, twin)           # the object index pass the comparison's mask reads
+    cycles, index, _ = lookdev_twin.render_rt_lit(scene, resolution, 1, str(tmp_path))
+    stats = lookdev_twin.eevee_against_cycles(scene, resolution, cycles, index, str(tmp_path), print)
+    if "skipped" in stats:
+        pytest.skip(stats["skipped"])
+    assert stats["count"] > 5000 and 0.0 < stats["median"] <= lookdev_twin.EEVEE_MEDIAN_MAX, stats

@@ -220,7 +220,7 @@ def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee
         result["seconds"] = {"rt_lit_cycles": float(np.median(t_a)), "rt_lit_runs": t_a,
                              "path_traced": float(np.median(reference["seconds"]))}
         if eevee:
-            result["eevee"] = _eevee_against_cycles(scene, resolution, a, result["index"], tmp, log)
+            result["eevee"] = eevee_against_cycles(scene, resolution, a, result["index"], tmp, log)
         refs, free = reference["shadowed"], reference["unshadowed"]
         result["images"] = {"rt_lit": a.astype(np.float32), "path_traced": (0.5 * (refs[0] + refs[1])).astype(np.float32)}
         if free is not None:
@@ -228,7 +228,7 @@ def compare(scene, twin, resolution=(320, 160), samples=256, seeds=(0, 1), eevee
     return result
 
 
-def _eevee_against_cycles(scene, resolution, cycles, index, folder, log):
+def eevee_against_cycles(scene, resolution, cycles, index, folder, log):
     """EEVEE's render of the lookdev scene against (a), where EEVEE can render here."""
     from ..harness.engines import compare as compare_engines
     from ..harness.engines import eevee_available, render_engines
