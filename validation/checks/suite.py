@@ -340,16 +340,18 @@ def gates_module(result):
     return "\n".join(lines) + "\n"
 
 
-def gates_markdown(result):
-    """The pooled (a) vs (c) figures of a run with the gates they imply: docs/benchmarks/validation.md."""
-    gates = measured_gates(result["pooled"])
+def gates_markdown(result, gates=None, note=""):
+    """The pooled (a) vs (c) figures of a run with the gates they imply (or ``gates``, the ones in force, said in
+    ``note``): docs/benchmarks/validation.md."""
+    gates = measured_gates(result["pooled"]) if gates is None else gates
     L = ["# Validation suite: pooled error per technique and light kind", "",
          f"`python scripts/validate.py` (validation/checks/suite.py), Blender {result['settings']['blender']}, "
          f"{result['settings']['samples']} samples x {len(result['settings']['seeds'])} seeds per Cycles reference, "
          f"{result['timings_s']['total']:.0f} s. Relative error of the node render (a) against the ground truth (c) "
          f"over the values above {result['settings']['floor']:g} x each sphere's maximum, pooled per technique and "
          "light kind; the reference's own noise beside it; the gate that `validation/checks/suite.py` `GATES` holds "
-         f"({GATE_MARGIN:g} x the measurement, rounded up; within {GATE_NOISE_FACTOR:g}x the noise also passes).", "",
+         f"({GATE_MARGIN:g} x the measurement, rounded up; within {GATE_NOISE_FACTOR:g}x the noise also passes)."
+         + (f" {note}" if note else ""), "",
          "| technique | light | truth | values | median | p90 | reference noise (median / p90) | gate (median / p90) |",
          "|---|---|---|---|---|---|---|---|"]
     for g in result["pooled"]:
