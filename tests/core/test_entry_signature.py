@@ -30,6 +30,7 @@ CONVERTED = {
     "benchmarks/realtime_benchmark": "benchmark_realtime.py",
     "benchmarks/rt_lit_benchmark": "benchmark_rt_lit.py",
     "benchmarks/specular_occlusion_benchmark": "benchmark_specular_occlusion.py",
+    "benchmarks/spread_benchmark": "benchmark_spread.py",
     "benchmarks/wrapped_diffuse_benchmark": "benchmark_wrapped_diffuse.py",
     "benchmarks/floor_shadows_benchmark": "benchmark_floor_shadows.py",
     "benchmarks/concave_shadows_benchmark": "benchmark_concave_shadows.py",
