@@ -69,7 +69,8 @@ def draw_case(rng, form):
 
 
 def shaded_light(form, position, centre, geom, spread):
-    """The light RT Lit shades (core/light_spread.py ``spread_quad`` / ``spread_disk``) and whether the cone meets it."""
+    """The light RT Lit shades (core/light_spread.py ``spread_quad`` / ``spread_disk``) and whether the cone meets
+    it."""
     half_u, half_v = geom
     if form == "quad":
         c, eu, ev, cone, hits = light_spread.spread_quad(position, centre, half_u, half_v, spread)
