@@ -610,7 +610,10 @@ def spread_disk(position, centre, axis_u, axis_v, spread):
     d = op.length(op.vec3(foot_u, foot_v, 0.0))
     light_in_circle = op.less(d + op.maximum(a, b), cone.radius)
     radius = op.sqrt(a * b)
-    misses = op.greater(d, radius + cone.radius)
+    # it misses where the foot is farther than R from the ellipse: at least (inside - 1) min(a, b) away, the map to
+    # the unit circle shrinking no distance by more than min(a, b) (the equal-area circle, d > sqrt(a b) + R, culled a
+    # thin ellipse's light along its length)
+    misses = op.greater((inside - 1.0) * op.minimum(a, b), cone.radius)
     # partial overlap: the lens of the light's equal-area circle and the cone's circle
     area, apex_far, apex_near, width = _lens(radius, cone.radius, op.maximum(d, 1e-12))
     towards = op.normalize(op.scale(unit_u, foot_u) + op.scale(unit_v, foot_v))

@@ -696,6 +696,25 @@ def _disk_spread_truth(position, radius, height, spread, density, radial=200, an
     return float(np.sum(_spread_weight(q, position, spread) * density(w) * w[:, 2] / r2 * area))
 
 
+def test_spread_disk_culls_only_lights_the_cone_misses():
+    """Regression: ``spread_disk`` culled a light when the cone's foot was farther than R from the circle of the
+    light's area, so a thin ellipse (1 m x 1 mm) lost its light along its length (hits 0 with the foot on the light
+    itself).  It culls where the foot is surely farther than R from the ellipse now: (distance in its unit-circle
+    coordinates - 1) x the smaller semi-axis; for a round disk the same test as before."""
+    spread_disk = lights.light_spread.spread_disk
+    centre, axis_u, axis_v = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1e-3, 0.0])
+    for foot_x, reach, lit in ((0.5, 0.1, 1.0), (0.99, 0.05, 1.0), (0.3, 0.001, 1.0)):
+        spread = 2 * math.atan(reach)                                 # R = tan(spread / 2) at 1 m
+        hits = spread_disk(np.array([foot_x, 0.0, 0.0]), centre, axis_u, axis_v, spread)[4]
+        assert float(hits) == lit, (foot_x, reach)
+    # beside the ellipse's width, out of reach: culled; a round disk as before (d > a + R)
+    hits = spread_disk(np.array([0.0, 0.05, 0.0]), centre, axis_u, axis_v, 2 * math.atan(0.01))[4]
+    assert float(hits) == 0.0
+    disk_v = np.array([0.0, 1.0, 0.0])
+    for d, reach, lit in ((1.5, 0.6, 1.0), (1.5, 0.4, 0.0)):
+        assert float(spread_disk(np.array([d, 0.0, 0.0]), centre, axis_u, disk_v, 2 * math.atan(reach))[4]) == lit
+
+
 @pytest.mark.parametrize("lobe, median_limit, p90_limit", [("lambert", 0.01, 0.05), ("ggx r 0.1", 0.03, 0.25)])
 def test_spread_on_a_disk(energy_tables, lobe, median_limit, p90_limit):
     """Issue 27: a disk light with spread 90 deg (radius 0.3-1 m at 0.6-2 m, 30 seeded receivers viewing near the
