@@ -276,9 +276,17 @@ def disney_sheen_fitted(tables, light, p, n, v, sheen_color):
 def lambert(tables, light, p, n, v, albedo):
     """Lambert's form factor of the light (clipped at the horizon where the light says so) times ``albedo``."""
     frame = polygon.local_frame(n, v)
+    if isinstance(light, DiskLight) and light.spread is not None:
+        return disk_spread_form_factor(light, frame[2], p) * albedo
     if isinstance(light, QuadLight) and light.exact_horizon:
         return light.clipped_form_factor(frame, p) * albedo
     return light.integral(tables, IDENTITY, frame, p) * albedo
+
+
+def disk_spread_form_factor(light, n, p):
+    """Lambert's form factor of a disk light with spread, exact along each ray (``light_spread.LAMBERT_DISK``; the
+    horizon clipped whatever the light's ``exact_horizon``), 0 behind a one-sided light."""
+    return light_spread.lambert_disk_form_factor(light.spread, p, n, light.two_sided)
 
 
 def light_center(light):

@@ -62,8 +62,9 @@ def light_capacity(features, world=False):
 #: runs out of SVM stack and renders black; quads and disks gave the same verdicts.  Measured 2026-12-07 on the plane of
 #: tests/blender/test_light_model.py under one 1.5 m light with a 40-degree spread, Sheen and Cloth Weight 0.5 (at 0
 #: Cycles folds those lobes away), peaks from Cycles 4.5's log (GLOG_v=5) of its 255 floats, quad / disk: Lambert
-#: 99 / 151, Lambert + cloth 145 / 208, Turquin + CoD 153 / 231, Turquin + CoD + Zeltner sheen 161 / 236,
-#: Kulla-Conty + Lambert 159 / 234, every switch on out of stack under both.  Blender 5.x renders every set.
+#: 99 / 51 (151 before Lambert's disk rule exact along rays, light_spread.LAMBERT_DISK), Lambert + cloth 145 / 182
+#: (208), Turquin + CoD 153 / 231, Turquin + CoD + Zeltner sheen 161 / 236, Kulla-Conty + Lambert 159 / 225 (234),
+#: every switch on out of stack under both.  Blender 5.x renders every set.
 SPREAD_IN_4 = {
     **dict.fromkeys((Features("none", "lambert"), Features("none", "lambert", cloth=True), Features("turquin", "cod"),
                      Features("turquin", "cod", sheen="zeltner"), Features("kulla_conty", "lambert")), True),

@@ -176,7 +176,7 @@ CASES = {
                                                 spread=math.radians(90.0)), ("approx", 0.005, 0.02)),
     "spread 40 deg, disk": (lambda bpy, sc, _: _light(bpy, sc, "AREA", (0.2, 0.1, 0.9), DOWN, energy=40.0,
                                                       shape="DISK", size=1.5, spread=math.radians(40.0)),
-                            ("approx", 0.10, 0.15)),
+                            ("approx", 0.008, 0.025)),
     "normalize off, area": (lambda bpy, sc, _: _light(bpy, sc, "AREA", (0.2, 0.1, 1.0), DOWN, energy=10.0,
                                                       size=0.7, normalize=False), "exact"),
     "normalize off, point": (lambda bpy, sc, _: _light(bpy, sc, "POINT", (0.2, 0.1, 1.0), energy=10.0,

@@ -13,7 +13,8 @@ apart, so that what a rule could still gain is known.
 Cases (seeded): a quad (0.4-2 m a side) or a disk (radius 0.3-1 m) facing -Z at 0.6-2.5 m, the receiver within
 1.2 m of the light's axis with its normal tilted up to about 50 degrees, viewing near the mirror direction of a point
 of the light (the highlight; as tests/core/test_lights.py draws them), spreads 40 and 90 degrees.  Lobes: Lambert
-(the identity LTC, exact without spread) and GGX (F = 1, height-correlated Smith) at r = 0.1-0.55, below the band
+(``shading.lambert``: the identity LTC, exact without spread; on a disk with spread the rule exact along each ray,
+``light_spread.LAMBERT_DISK``) and GGX (F = 1, height-correlated Smith) at r = 0.1-0.55, below the band
 (``ltc_ggx`` is one LTC there).  Truth: a midpoint rule over the light (quads 300 x 300, disks 160 radii x 320
 angles) of f cos times w per solid angle.  Relative errors over the cases whose truth is above 1e-3 of the light's
 unit radiance: median / p90.  Writes ``spread.md`` and ``spread.json`` in ``--out``.
@@ -156,9 +157,14 @@ def case_values(tables, form, case, spread, lobe, roughness, quick):
     ltc_weighted, _ = dense_integrals(points, area, position, spread,
                                       lambda w: matrix.density_packed(np.array(packed)[None], w @ basis.T)[0])
     _, plain_truth = dense_integrals(points, area, position, np.pi, f_cos)
-    return {"rt_lit": float(light.integral(tables, packed, frame, position)) * hits * scale,
-            "ltc_weighted": ltc_weighted * scale, "truth": truth,
-            "plain": float(plain_light(form, centre, geom).integral(tables, packed, frame, position)) * scale,
+    plain = plain_light(form, centre, geom)
+    if lobe == "lambert":       # RT Lit's Lambert lobe (shading.lambert: on a disk with spread, exact along its rays)
+        rt_lit = float(shading.lambert(tables, light, position, normal, view, 1.0)) * hits
+        plain_value = float(shading.lambert(tables, plain, position, normal, view, 1.0))
+    else:
+        rt_lit = float(light.integral(tables, packed, frame, position)) * hits * scale
+        plain_value = float(plain.integral(tables, packed, frame, position)) * scale
+    return {"rt_lit": rt_lit, "ltc_weighted": ltc_weighted * scale, "truth": truth, "plain": plain_value,
             "plain_truth": plain_truth}
 
 
