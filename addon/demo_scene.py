@@ -83,7 +83,7 @@ def build_demo_scene(lut_dir=None, resolution=256, hdri=DEFAULT_HDRI, world_stre
     scene.world = None
     if hdri and hdri != "none":
         add_hdri_world(bpy, scene, hdri, world_strength)
-    rtl_world.sync_world(scene)       # no usable image: no "RTL World" group, no World term
+    rtl_world.sync_world(scene)       # a world that shows nothing: no "RTL World" group, no World term
 
     # lights first: the RT Lit groups are built for the scene's lights
     root = scene.collection

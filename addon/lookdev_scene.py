@@ -227,7 +227,7 @@ def studio_scene(name, hdri, world_strength, view_transform, resolution, advance
     if hdri is not None:
         world = add_hdri_world(scene, hdri, world_strength, name=f"{name} {hdri}")
         world.cycles.sampling_method = "AUTOMATIC"   # the twin path-traces this world
-    rtl_world.sync_world(scene)          # bakes (cached) the HDRI; no usable image: no World term
+    rtl_world.sync_world(scene)          # bakes (cached) the HDRI; no world: no World term
     if advance is not None:
         advance()
     _studio_lights(scene.collection)

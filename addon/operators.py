@@ -339,9 +339,9 @@ class RTL_OT_add_node_groups(bpy.types.Operator):
 
 
 class RTL_OT_sync_world(ModalTask, bpy.types.Operator):
-    """Bake the World's environment image (cached by its content) and rebuild the RT Lit groups with
-    its light; without a usable image (Background <- Environment Texture [<- Mapping]) the World
-    term is off.  Changing the World's strength or Mapping rotation needs no sync: drivers follow it.
+    """Bake what the World shows (its environment image, its plain colour, or else Cycles' render of its nodes;
+    cached by content) and rebuild the RT Lit groups with its light; a world that shows nothing has no World
+    term.  Changing the World's strength or Mapping rotation needs no sync: drivers follow it.
     The bake runs in the background (Esc cancels)"""
 
     bl_idname = "rtl.sync_world"
@@ -363,7 +363,8 @@ class RTL_OT_sync_world(ModalTask, bpy.types.Operator):
         try:
             job = world.bake_job(scene) if setup.usable else None
         except Exception as ex:
-            self.report({'ERROR'}, f"Could not read the world's image: {ex}")
+            what = "render the world" if setup.source == "render" else "read the world's image"
+            self.report({'ERROR'}, f"Could not {what}: {ex}")
             return {'CANCELLED'}
 
         def work(progress):

@@ -106,11 +106,15 @@ class RTL_PT_world(_PropertiesPanel, bpy.types.Panel):
         setup = world.world_setup(context.scene.world)
         col = layout.column(align=True)
         if setup.usable:
-            col.label(text=f"Environment: {setup.image.name}", icon='CHECKMARK')
+            col.label(text=f"Environment: {setup.label}", icon='CHECKMARK')
+            if setup.note:
+                col.label(text=setup.note)
             group = bpy.data.node_groups.get(world.WORLD_GROUP)
             record = group.get(world.RECORD_KEY) if group is not None else None
-            if record is None or record.get("image") != setup.image.name:
+            if record is None or record.get("image") != setup.label:
                 col.label(text="Not synced: RT Lit shades no World term yet", icon='INFO')
+            elif setup.source != "image":
+                col.label(text="Changes to the world's nodes need a sync (strength is live)", icon='INFO')
         else:
             col.label(text="RT Lit World term off:", icon='INFO')
             col.label(text=setup.reason)

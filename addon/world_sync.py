@@ -1,16 +1,25 @@
-"""The scene's World as RT Lit sees it: find its equirect image, bake it, expose it as a node group.
+"""The scene's World as RT Lit sees it: find what it shows, bake it, expose it as a node group.
 
-- ``world_setup(world)`` walks the active World Output: Background <- Environment Texture
-  (equirectangular, an image with pixels) [<- Mapping (Point or Vector, rotation only) <- Texture
-  Coordinate > Generated].  Anything else gives a ``reason`` and no World term.
-- ``bake_world(scene)`` reads the image's pixels (``world_image_array``: scene-linear RGB, top row
-  first) and bakes them with ``core.environment.prefilter.bake_environment_image`` into a cache
-  folder (``default_cache_dir``), named by the image's content hash, so a re-sync of an unchanged
-  image only hashes it and reads the cached headers.
+- ``world_setup(world)`` walks the active World Output and says where the world's radiance comes from
+  (``WorldSetup.source``):
+  - "image": Background <- Environment Texture (equirectangular, an image with pixels) [<- Mapping (Point or
+    Vector, rotation only) <- Texture Coordinate > Generated]: the image's pixels are read;
+  - "constant": a Background whose Color is a plain colour (every new Blender file's world), or a world without
+    nodes (its Color): no render, the colour is the image;
+  - "render": anything else Cycles can draw (a Sky Texture, a Mix, Object coordinates, a Mapping with scale, an
+    8-bit image in another colour space, a Mix Shader of Backgrounds...): the world rendered by Cycles through an
+    equirectangular panoramic camera (``render_world_array``) is the image, ``WorldSetup.note`` says why;
+  only a world that shows nothing (none, no World Output, nothing or a muted Background into it) gives a
+  ``reason`` and no World term.
+- ``bake_world(scene)`` bakes that image (``world_array``: scene-linear RGB, top row first) with
+  ``core.environment.prefilter.bake_environment_image`` into a cache folder (``default_cache_dir``), named by its
+  content hash, so a re-sync of an unchanged world only hashes it (after the render, for a rendered world) and reads
+  the cached headers.
 - ``sync_world(scene)`` (re)builds the shared group "RTL World": the 9 baked SH coefficients as
   static Combine XYZ values, and the Background strength and the Mapping rotation as Value /
   Combine XYZ nodes driven by simple-expression drivers (SINGLE_PROP on the World), so the strength
-  and rotation stay live without a re-bake and evaluate without Python after a reload.
+  and rotation stay live without a re-bake and evaluate without Python after a reload (a rendered world whose
+  strength is not the Background's own value is baked with it, and its strength is 1).
 
 Measured with bpy 5.0.1 (small Cycles renders; tests/blender/test_world_setup.py checks the rest):
 - ``World.use_nodes`` is deprecated in 5.0 and setting it to False is ignored (the world always
@@ -31,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import re
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -61,18 +71,50 @@ _IMAGE_SOURCES = ("FILE", "GENERATED")
 
 # --- the world's setup -------------------------------------------------------------------------------
 
+#: The panoramic render of a world that is neither an image nor a constant (``render_world_array``): width (the
+#: height is half), samples per pixel over a one-pixel box filter (each pixel the average of the world over its
+#: area, as the bake's area averaging wants), and the bake's largest source width (``PrefilterSettings``).
+RENDER_WIDTH = 1024
+RENDER_SAMPLES = 16
+
+
 @dataclass
 class WorldSetup:
-    """What ``world_setup`` found: the image (None when not usable), the Background and Mapping nodes
-    (None when absent), and why the world is not usable ("" when it is)."""
+    """What ``world_setup`` found: where the world's radiance comes from (``source``: "image", "constant",
+    "render", or "" when the world shows nothing), the image (source "image"), the colour (source "constant"),
+    the Background and Mapping nodes (None when absent), why a rendered world is rendered (``note``), and why the
+    world is not usable ("" when it is)."""
     image: object = None
     background: object = None
     mapping: object = None
     reason: str = ""
+    source: str = ""
+    colour: tuple = None
+    note: str = ""
+    world: object = None
 
     @property
     def usable(self):
-        return self.image is not None and not self.reason
+        return bool(self.source) and not self.reason
+
+    @property
+    def live_strength(self):
+        """The Background's Strength socket when the bake leaves it out (a live, driven value), else None."""
+        bg = self.background
+        if bg is None or not self.usable or _link_into(bg.inputs["Strength"]) is not None:
+            return None
+        return bg.inputs["Strength"]
+
+    @property
+    def label(self):
+        """What RT Lit shades, in a few words (the panel, the reports, the group's record)."""
+        if self.source == "image":
+            return self.image.name
+        if self.source == "constant":
+            return "plain colour (" + ", ".join(f"{c:.3g}" for c in self.colour) + ")"
+        if self.source == "render":
+            return f"World '{self.world.name}' rendered"
+        return ""
 
 
 def _link_into(socket):
@@ -161,14 +203,16 @@ def _coordinates_reason(link, into):
 
 
 def world_setup(world):
-    """The ``WorldSetup`` of ``world`` (a bpy World or None).  Usable: the active World Output's Surface
-    comes from a Background node whose Color comes directly from an equirectangular Environment
-    Texture with an image that has pixels; that texture's Vector is unlinked, Texture Coordinate >
-    Generated, or a Mapping node (Point or Vector, rotation only) fed by Texture Coordinate > Generated."""
+    """The ``WorldSetup`` of ``world`` (a bpy World or None): an image where the active World Output's Surface
+    comes from a Background whose Color comes directly from an equirectangular Environment Texture with an image
+    that has pixels, its Vector unlinked, Texture Coordinate > Generated, or a Mapping node (Point or Vector,
+    rotation only) fed by Texture Coordinate > Generated; a constant where the Background's Color is unlinked (or
+    the world has no nodes); a render for anything else that shows something."""
     if world is None:
         return WorldSetup(reason="the scene has no World")
     if not _uses_nodes(world) or world.node_tree is None:
-        return WorldSetup(reason=f"World '{world.name}' does not use nodes")
+        return WorldSetup(source="constant", colour=tuple(float(c) for c in world.color[:3]), world=world,
+                          note=f"World '{world.name}' does not use nodes: its Color")
     tree = world.node_tree
     output = tree.get_output_node("CYCLES")
     if output is None:
@@ -178,18 +222,32 @@ def world_setup(world):
         return WorldSetup(reason=f"the World Output of '{world.name}' has nothing linked to its Surface")
     background = link.from_node
     if background.bl_idname != "ShaderNodeBackground":
-        return WorldSetup(reason=f"the World Output's Surface comes from {_describe(background)}, not a Background node")
-    setup = WorldSetup(background=background)
+        return _rendered(world, None, f"the World Output's Surface comes from {_describe(background)}")
     if background.mute:
-        setup.reason = f"the Background node '{background.name}' is muted"
-        return setup
+        return WorldSetup(background=background,
+                          reason=f"the Background node '{background.name}' is muted (the world shows nothing)")
     if _link_into(background.inputs["Strength"]) is not None:
-        setup.reason = "the Background node's Strength is linked (a value is needed)"
-        return setup
+        return _rendered(world, background, "the Background node's Strength is linked")
     link = _link_into(background.inputs["Color"])
     if link is None:
-        setup.reason = "the Background has a plain colour, no Environment Texture"
-        return setup
+        colour = tuple(float(c) for c in background.inputs["Color"].default_value[:3])
+        return WorldSetup(source="constant", colour=colour, background=background, world=world)
+    setup = _environment_image(background, link)
+    if setup.reason:
+        return _rendered(world, background, setup.reason)
+    setup.source, setup.world = "image", world
+    return setup
+
+
+def _rendered(world, background, why):
+    """A world drawn by Cycles (``render_world_array``); ``why`` it is not read as an image or a colour."""
+    return WorldSetup(source="render", background=background, world=world, note=f"{why}: rendered by Cycles")
+
+
+def _environment_image(background, link):
+    """The ``WorldSetup`` of a Background whose Color comes through ``link``: its image, or why it is not one
+    equirectangular image read as it is."""
+    setup = WorldSetup(background=background)
     env = link.from_node
     if env.bl_idname != "ShaderNodeTexEnvironment":
         setup.reason = f"the Background's Color comes from {_describe(env)}, not an Environment Texture"
@@ -201,7 +259,7 @@ def world_setup(world):
         setup.reason = f"the Environment Texture '{env.name}' is muted"
         return setup
     if env.projection != "EQUIRECTANGULAR":
-        setup.reason = f"the Environment Texture uses {env.projection.replace('_', ' ').lower()} projection (equirectangular only)"
+        setup.reason = f"the Environment Texture uses {env.projection.replace('_', ' ').lower()} projection"
         return setup
     if env.image is None:
         setup.reason = "the Environment Texture has no image"
@@ -213,8 +271,6 @@ def world_setup(world):
             setup.reason = _mapping_reason(setup.mapping)
         else:
             setup.reason = _coordinates_reason(link, "the Environment Texture's Vector")
-            if setup.reason:
-                setup.reason += " (a Mapping node with rotation only is supported)"
         if setup.reason:
             return setup
     setup.reason = _image_reason(env.image)
@@ -250,6 +306,70 @@ def world_image_array(image):
     return rgb
 
 
+def world_array(setup):
+    """(H, W, 3) float32 scene-linear RGB, top scanline first, of what a usable ``setup`` shows at strength 1
+    where its strength is live (``WorldSetup.live_strength``): the image's pixels, the constant colour as one
+    texel (the bake replicates it), or Cycles' render of the world."""
+    if setup.source == "image":
+        return world_image_array(setup.image)
+    if setup.source == "constant":
+        colour = np.nan_to_num(np.asarray(setup.colour, np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+        return np.maximum(colour, 0.0).reshape(1, 1, 3)
+    if setup.source == "render":
+        unit = setup.live_strength is not None
+        return render_world_array(setup.world, setup.background.name if unit else None)
+    raise ValueError(f"the world is not usable: {setup.reason}")
+
+
+#: The panoramic camera's rotation that gives Cycles' equirectangular render the Environment Texture's layout
+#: (core/environment/equirect.py: row 0 at the zenith, u = 0.5 - atan2(y, x) / 2 pi): Euler XYZ (90, 0, -90) deg,
+#: measured (a world showing its Generated direction: tests/blender/test_world_setup.py).
+PANORAMA_ROTATION = (0.5 * np.pi, 0.0, -0.5 * np.pi)
+
+
+def render_world_array(world, unit_background=None, width=RENDER_WIDTH, samples=RENDER_SAMPLES):
+    """Cycles' equirectangular render of ``world`` (``width`` x ``width / 2``, ``samples`` per pixel over a
+    one-pixel box, no bounces: each pixel the world's mean over its area) as ``world_image_array`` returns
+    an image, in a scene of its own that is removed afterwards.  ``unit_background``: the name of a Background
+    node whose Strength is set to 1 in the copy rendered (its strength then stays a live value)."""
+    copy = world.copy()
+    scene = bpy.data.scenes.new("RTL world render")
+    camera = bpy.data.cameras.new("RTL world render")
+    obj = bpy.data.objects.new("RTL world render", camera)
+    image = None
+    try:
+        if unit_background is not None:
+            copy.node_tree.nodes[unit_background].inputs["Strength"].default_value = 1.0
+        camera.type = "PANO"
+        camera.panorama_type = "EQUIRECTANGULAR"
+        obj.rotation_euler = PANORAMA_ROTATION
+        scene.collection.objects.link(obj)
+        scene.camera, scene.world = obj, copy
+        render = scene.render
+        render.engine = "CYCLES"
+        render.resolution_x, render.resolution_y, render.resolution_percentage = width, width // 2, 100
+        render.film_transparent = False
+        cycles = scene.cycles
+        cycles.device, cycles.samples, cycles.seed = "CPU", samples, 0
+        cycles.use_adaptive_sampling = cycles.use_denoising = False
+        cycles.max_bounces = 0
+        cycles.pixel_filter_type, cycles.filter_width = "BOX", 1.0
+        compat.set_exr_output(render.image_settings)
+        with tempfile.TemporaryDirectory(prefix="rtl-world-") as folder:
+            render.filepath = str(Path(folder) / "world.exr")
+            bpy.ops.render.render(write_still=True, scene=scene.name)
+            image = bpy.data.images.load(render.filepath)
+            image.reload()
+            return world_image_array(image)
+    finally:
+        if image is not None:
+            bpy.data.images.remove(image)
+        bpy.data.scenes.remove(scene)
+        bpy.data.objects.remove(obj)
+        bpy.data.cameras.remove(camera)
+        bpy.data.worlds.remove(copy)
+
+
 def default_cache_dir():
     """The bake cache: the preference "Environment Cache" when set, else ``$RTL_ENVIRONMENT_CACHE``, else
     ``$XDG_CACHE_HOME/rt_lookdev/environments`` (``~/.cache`` when XDG_CACHE_HOME is unset); created here."""
@@ -269,13 +389,21 @@ def default_cache_dir():
     return path
 
 
-def _file_stem(image):
-    stem = Path(image.name).stem if "." in image.name else image.name
+def _file_stem(setup):
+    if setup.source == "constant":
+        return "plain"
+    name = setup.image.name if setup.source == "image" else setup.world.name
+    stem = Path(name).stem if "." in name and setup.source == "image" else name
     stem = re.sub(r"[^A-Za-z0-9_-]+", "_", stem).strip("_")[:48]
     return stem or "world"
 
 
-def _image_source(image):
+def _source(setup):
+    if setup.source == "constant":
+        return "constant:" + ",".join(repr(float(c)) for c in setup.colour)
+    if setup.source == "render":
+        return f"render:{setup.world.name}"
+    image = setup.image
     if image.packed_file is not None:
         return f"packed:{image.name}"
     if image.source == "GENERATED" or not image.filepath:
@@ -283,28 +411,38 @@ def _image_source(image):
     return bpy.path.abspath(image.filepath, library=image.library)
 
 
+@dataclass
+class BakeJob:
+    """The bake of a world as a function of ``progress(stage, done, total)`` alone, touching no ``bpy``, so it can
+    run in a background thread (``background_task``): ``array`` is what the world shows (``world_array``, read or
+    rendered on the calling thread), the rest where and how it is baked."""
+    array: np.ndarray
+    name: str
+    source: str
+    out_dir: Path
+    settings: object
+    force: bool = False
+
+    def __call__(self, progress=None):
+        return prefilter.bake_environment_image(self.array, self.name, self.source, self.out_dir, self.settings,
+                                                progress, self.force)
+
+
 def bake_job(scene, cache_dir=None, force=False, settings=None):
-    """The bake of ``scene``'s World as a function of ``progress(stage, done, total)`` alone, touching no
-    ``bpy`` (the image is read here, on the calling thread), so it can run in a background thread
-    (``background_task``); None when the world has no usable image (``world_setup`` says why)."""
+    """The ``BakeJob`` of ``scene``'s World (the image read, or the world rendered, here); None when the world
+    shows nothing (``world_setup`` says why)."""
     setup = world_setup(scene.world)
     if not setup.usable:
         return None
-    image = setup.image
-    array = world_image_array(image)
-    name = f"{_file_stem(image)}_{equirect.image_hash(array)[:12]}"
-    source = _image_source(image)
+    array = world_array(setup)
     out_dir = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    settings = settings or prefilter.PrefilterSettings()
-
-    def bake(progress=None):
-        return prefilter.bake_environment_image(array, name, source, out_dir, settings, progress, force)
-    return bake
+    return BakeJob(array, f"{_file_stem(setup)}_{equirect.image_hash(array)[:12]}", _source(setup), out_dir,
+                   settings or prefilter.PrefilterSettings(), force)
 
 
 def bake_world(scene, cache_dir=None, progress=None, force=False, settings=None):
     """Bake (or find cached) the environment of ``scene``'s World: an ``EnvironmentBake``, or None when
-    the world has no usable image (``world_setup`` says why).  Files ``<image>_<hash12>_*`` in
+    the world shows nothing (``world_setup`` says why).  Files ``<image>_<hash12>_*`` in
     ``cache_dir`` (default ``default_cache_dir()``); ``progress(stage, done, total)`` as in core;
     ``settings``: ``PrefilterSettings`` (default: the measured defaults)."""
     job = bake_job(scene, cache_dir, force, settings)
@@ -334,7 +472,8 @@ def _drive(socket, world, data_path):
 
 def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
     """(Re)build "RTL World" for ``scene``'s World and return its record ({"table", "prefiltered", "sh",
-    "source_hash", "image"}); when the world has no usable image, remove the group and return None.
+    "source_hash", "image" (``WorldSetup.label``), "source"}); when the world shows nothing, remove the group and
+    return None.
 
     ``bake``: an ``EnvironmentBake`` of this world already made by ``bake_world`` (else it is made here
     with ``cache_dir``, ``progress``, ``settings``).  The group's interface is kept when unchanged, so
@@ -372,13 +511,13 @@ def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
     for i, name in enumerate(SH_NAMES):
         combine(name, bake.sh_image[i], i)
 
-    background = setup.background
-    strength_socket = background.inputs["Strength"]
+    strength_socket = setup.live_strength
     value = ng.nodes.new("ShaderNodeValue")
     value.name = value.label = "Strength"
     value.location = (0.0, -SH_COUNT * 140.0)
-    value.outputs[0].default_value = float(strength_socket.default_value)
-    _drive(value.outputs[0], world, _input_path(background, strength_socket))
+    value.outputs[0].default_value = 1.0 if strength_socket is None else float(strength_socket.default_value)
+    if strength_socket is not None:
+        _drive(value.outputs[0], world, _input_path(setup.background, strength_socket))
     ng.links.new(value.outputs[0], output(world_input("Strength")))
 
     mapping = setup.mapping
@@ -389,7 +528,7 @@ def sync_world(scene, cache_dir=None, progress=None, settings=None, bake=None):
             _drive(rotation.inputs[axis], world, f"{path}[{axis}]")
 
     record = {"table": bake.table_name, "prefiltered": str(bake.prefiltered_path),
-              "sh": str(bake.sh_path), "source_hash": bake.source_hash, "image": setup.image.name,
+              "sh": str(bake.sh_path), "source_hash": bake.source_hash, "image": setup.label, "source": setup.source,
               "roughness_levels": _roughness_levels(bake)}
     ng[RECORD_KEY] = record
     return record
@@ -489,7 +628,8 @@ def world_parameters(scene, cache_dir=None, settings=None):
     else:
         sh = bake_world(scene, cache_dir, settings=settings).sh_image
     params = {name: np.asarray(sh[i], dtype=np.float64) for i, name in enumerate(SH_NAMES)}
-    params["Strength"] = float(setup.background.inputs["Strength"].default_value)
+    strength = setup.live_strength
+    params["Strength"] = 1.0 if strength is None else float(strength.default_value)
     params["Rotation"] = np.array(_rotation(setup), dtype=np.float64)
     return params
 
@@ -503,5 +643,6 @@ def bake_summary(bake):
     return f"baked in {seconds:.1f} s (" + ", ".join(f"{k} {v}" for k, v in states.items()) + ")"
 
 
-__all__ = ["WORLD_GROUP", "WorldSetup", "world_setup", "world_image_array", "default_cache_dir", "bake_world",
+__all__ = ["WORLD_GROUP", "WorldSetup", "BakeJob", "bake_job", "world_setup", "world_image_array", "world_array", "render_world_array",
+           "default_cache_dir", "bake_world",
            "sync_world", "world_environment", "world_parameters", "remove_world_group", "bake_summary"]

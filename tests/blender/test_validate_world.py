@@ -91,3 +91,39 @@ def test_sh_ltc_beats_magnitude_only(world_validation):
 def test_gates_passed(world_validation):
     result, _ = world_validation
     assert result["passed"], [c for c in result["checks"] if not c["ok"]]
+
+
+#: Issue 33: a plain-colour world (every new file's) against Cycles, RT Lit's Lambert and F = 1 GGX spheres
+#: (measured at full size, `python scripts/validate_world.py --node-world plain`: Lambert median 0.00%, GGX
+#: medians 0.01-0.09%, p90 <= 0.21%).
+PLAIN_MEDIAN = 0.005
+
+
+@pytest.fixture(scope="module")
+def node_worlds(tmp_path_factory, lut_dir, bpy_module):
+    """``--quick --node-world plain --node-world mix``: a plain-colour world (baked as a constant, no render) and a
+    Mix-node world (baked from Cycles' panoramic render of it)."""
+    from rt_lookdev.validation.checks import world_suite as validate_world
+
+    out = tmp_path_factory.mktemp("validation_node_worlds")
+    argv = ["--quick", "--no-bake-timing", "--skip-furnace", "--node-world", "plain", "--node-world", "mix",
+            "--out", str(out), "--lut-dir", str(lut_dir), "--harness-lambert-median", str(HARNESS_MEDIAN)]
+    return validate_world.run(validate_world.parse_args(argv), log=lambda s: None)
+
+
+@pytest.mark.development_release_only
+def test_plain_and_mix_worlds_shade_as_cycles(node_worlds):
+    """In the development release only (a minute of Cycles; 4.5 renders worlds through the same panoramic camera,
+    test_world_setup.py's layout test runs there).  Issue 33: RT Lit objects under a plain-colour world rendered black (Sync World refused it); a Mix-node world
+    was refused too.  Both are baked now, and the harness (the baked image's Lambert integral against Cycles'
+    Diffuse BSDF) is within noise for each, which pins the render's layout; the plain world's Lambert and GGX
+    spheres are within 0.5% of Cycles; (a) node render = (b) numpy."""
+    worlds = {w["name"]: w for w in node_worlds["worlds"]}
+    assert set(worlds) == {"plain", "mix"}
+    assert node_worlds["passed"], [c for c in node_worlds["checks"] if not c["ok"]]
+    for world in worlds.values():
+        assert world["lambert"]["image_vs_cycles"]["median"] <= HARNESS_MEDIAN, world["name"]
+    for v in worlds["plain"]["variants"]:
+        if v["technique"] in ("lambert", "ggx"):
+            assert v["truth_metrics"]["median"] <= PLAIN_MEDIAN, (v["technique"], v["roughness"], v["truth_metrics"])
+    assert worlds["plain"]["source"] == "constant" and worlds["mix"]["source"] == "render"

@@ -68,7 +68,16 @@ def _world(bpy, scene, image=None, mapping=None, coords=True):
     return world
 
 
-def test_world_setup_reasons(bpy_module, world_mod):
+def _rendered(setup, why):
+    """A world that is neither one image nor a constant: Cycles renders it, and the note says why."""
+    assert setup.usable and setup.source == "render" and setup.image is None, setup
+    assert why in setup.note and setup.note.endswith("rendered by Cycles"), setup.note
+    return setup
+
+
+def test_world_setup_sources(bpy_module, world_mod):
+    """Issue 33: every world that shows something is usable: an equirect image read as it is, a plain colour as a
+    constant, anything else rendered by Cycles (the note says why); only a world showing nothing is refused."""
     bpy = bpy_module
     scene = bpy.context.scene
     setup = world_mod.world_setup(scene.world)
@@ -79,8 +88,8 @@ def test_world_setup_reasons(bpy_module, world_mod):
     nt = world.node_tree
     bg, env = nt.nodes["Background"], nt.nodes["Environment Texture"]
     setup = world_mod.world_setup(world)
-    assert setup.usable and setup.reason == "" and setup.image == image
-    assert setup.background == bg and setup.mapping is None
+    assert setup.usable and setup.reason == "" and setup.image == image and setup.source == "image"
+    assert setup.background == bg and setup.mapping is None and setup.label == "env.exr"
 
     # Blender 5.0 deprecates World.use_nodes and ignores False (the world renders its nodes)
     from rt_lookdev.addon import compat
@@ -91,7 +100,10 @@ def test_world_setup_reasons(bpy_module, world_mod):
         assert world_mod.world_setup(world).usable
     else:
         world.use_nodes = False
-        assert "does not use nodes" in world_mod.world_setup(world).reason
+        world.color = (0.2, 0.3, 0.4)
+        setup = world_mod.world_setup(world)          # Cycles renders the world's Color
+        assert setup.source == "constant" and setup.colour == pytest.approx((0.2, 0.3, 0.4))
+        assert "does not use nodes" in setup.note and setup.live_strength is None
         world.use_nodes = True
 
     # Texture Coordinate > Generated straight into the texture, and through a reroute: the same
@@ -101,43 +113,53 @@ def test_world_setup_reasons(bpy_module, world_mod):
     nt.links.new(reroute.outputs[0], env.inputs["Vector"])
     assert world_mod.world_setup(world).usable
     nt.links.new(tc.outputs["Object"], env.inputs["Vector"])
-    assert "Texture Coordinate > Generated" in world_mod.world_setup(world).reason
+    _rendered(world_mod.world_setup(world), "Texture Coordinate > Generated")
     nt.links.remove(env.inputs["Vector"].links[0])
 
     env.projection = "MIRROR_BALL"
-    assert "projection" in world_mod.world_setup(world).reason
+    _rendered(world_mod.world_setup(world), "projection")
     env.projection = "EQUIRECTANGULAR"
     link = bg.inputs["Color"].links[0]
     link.is_muted = True                     # a muted link is no link: a plain colour
-    assert "plain colour" in world_mod.world_setup(world).reason
+    bg.inputs["Color"].default_value = (0.05, 0.1, 0.2, 1.0)
+    setup = world_mod.world_setup(world)
+    assert setup.usable and setup.source == "constant" and setup.colour == pytest.approx((0.05, 0.1, 0.2))
+    assert setup.live_strength == bg.inputs["Strength"] and setup.label.startswith("plain colour")
     nt.links.remove(link)
-    assert "plain colour" in world_mod.world_setup(world).reason
+    assert world_mod.world_setup(world).source == "constant"
     nt.links.new(env.outputs["Color"], bg.inputs["Color"])
 
     env.image = None
-    setup = world_mod.world_setup(world)
-    assert not setup.usable and setup.image is None and "no image" in setup.reason
+    _rendered(world_mod.world_setup(world), "no image")
     missing = bpy.data.images.new("missing", 4, 4)
     missing.source = "FILE"
     missing.filepath = "/nonexistent/rtl_missing.exr"
     env.image = missing
-    assert "no pixels" in world_mod.world_setup(world).reason
+    _rendered(world_mod.world_setup(world), "no pixels")
     byte = _image(bpy, "byte", _environment()[:, :, :] / 8.0, float_buffer=False)
     env.image = byte
     assert world_mod.world_setup(world).usable             # 8-bit sRGB: decoded
     byte.colorspace_settings.name = "Linear Rec.2020"
-    assert "colour space" in world_mod.world_setup(world).reason
+    _rendered(world_mod.world_setup(world), "colour space")
     env.image = image
 
     emission = nt.nodes.new("ShaderNodeEmission")
     nt.links.new(emission.outputs[0], nt.nodes["World Output"].inputs["Surface"])
-    assert "not a Background" in world_mod.world_setup(world).reason
+    setup = _rendered(world_mod.world_setup(world), "Emission")
+    assert setup.live_strength is None                 # baked with whatever strength the tree gives
     nt.links.new(bg.outputs[0], nt.nodes["World Output"].inputs["Surface"])
     value = nt.nodes.new("ShaderNodeValue")
     nt.links.new(value.outputs[0], bg.inputs["Strength"])
-    assert "Strength is linked" in world_mod.world_setup(world).reason
+    assert _rendered(world_mod.world_setup(world), "Strength is linked").live_strength is None
     nt.links.remove(bg.inputs["Strength"].links[0])
-    assert world_mod.world_setup(world).usable
+    assert world_mod.world_setup(world).source == "image"
+    # what shows nothing is refused: a muted Background, nothing into the output, no output
+    bg.mute = True
+    setup = world_mod.world_setup(world)
+    assert not setup.usable and "muted" in setup.reason
+    bg.mute = False
+    nt.links.remove(nt.nodes["World Output"].inputs["Surface"].links[0])
+    assert "nothing linked" in world_mod.world_setup(world).reason
 
 
 @pytest.mark.parametrize("vector_type", ["POINT", "VECTOR"])
@@ -151,7 +173,7 @@ def test_world_setup_mapping(bpy_module, world_mod, vector_type):
     assert setup.usable and setup.mapping == m
 
     def reason():
-        r = world_mod.world_setup(world).reason
+        r = _rendered(world_mod.world_setup(world), "unsupported Mapping").note
         assert r.startswith("unsupported Mapping"), r
         return r
 
@@ -291,7 +313,7 @@ def test_sync_world_group_and_drivers(bpy_module, world_mod, small, tmp_path):
     bake = world_mod.bake_world(scene, tmp_path, settings=small)
     assert bake.states == {"sh": "cached", "prefiltered": "cached"}
     assert record == {"table": bake.table_name, "prefiltered": str(bake.prefiltered_path),
-                      "sh": str(bake.sh_path), "source_hash": bake.source_hash, "image": "env",
+                      "sh": str(bake.sh_path), "source_hash": bake.source_hash, "image": "env", "source": "image",
                       "roughness_levels": [0.0, 0.5, 1.0]}
     ng = bpy.data.node_groups[world_mod.WORLD_GROUP]
     assert ng["rtl_world"].to_dict() == record
@@ -322,7 +344,7 @@ def test_sync_world_group_and_drivers(bpy_module, world_mod, small, tmp_path):
         'node_tree.nodes["Mapping \\"rot\\""].inputs[2].default_value[2]'
 
     params = world_mod.world_parameters(scene)
-    assert params["Strength"] == 1.5
+    assert params["Strength"] == pytest.approx(bg.inputs["Strength"].default_value)
     np.testing.assert_allclose(params["Rotation"], (0.1, -0.2, 0.3), rtol=1e-6)
     for i in range(9):
         np.testing.assert_allclose(params[f"SH {i}"], bake.sh_image[i], rtol=1e-6)
@@ -352,8 +374,19 @@ def test_sync_world_group_and_drivers(bpy_module, world_mod, small, tmp_path):
     assert [s.default_value for s in ng.nodes["Rotation"].inputs[:3]] == [0.0, 0.0, 0.0]
     np.testing.assert_array_equal(world_mod.world_parameters(scene)["Rotation"], 0.0)
 
-    # a world without an image: the group goes, the World term is off
+    # a plain colour: a constant world (one texel baked), the strength still driven, no rotation
     world.node_tree.links.remove(bg.inputs["Color"].links[0])
+    bg.inputs["Color"].default_value = (0.2, 0.4, 0.8, 1.0)
+    record = world_mod.sync_world(scene, tmp_path, settings=small)
+    assert record["source"] == "constant" and record["image"] == "plain colour (0.2, 0.4, 0.8)"
+    assert [fc.data_path for fc in ng.animation_data.drivers] == ['nodes["Strength"].outputs[0].default_value']
+    params = world_mod.world_parameters(scene)
+    np.testing.assert_allclose(params["SH 0"], np.array([0.2, 0.4, 0.8]) * 2 * np.sqrt(np.pi), rtol=1e-5)
+    np.testing.assert_allclose([params[f"SH {i}"] for i in range(1, 9)], 0.0, atol=1e-6)
+    assert params["Strength"] == pytest.approx(bg.inputs["Strength"].default_value)
+
+    # a world that shows nothing: the group goes, the World term is off
+    bg.mute = True
     assert world_mod.sync_world(scene, tmp_path, settings=small) is None
     assert world_mod.WORLD_GROUP not in bpy.data.node_groups
     assert world_mod.world_parameters(scene) is None
@@ -430,7 +463,7 @@ def test_sync_world_switches_the_rt_lit_term_and_drops_stale_images(bpy_module, 
     assert second != first and env_images() == [f"RTL_{second}"]
     assert tuple(bpy.data.images[f"RTL_{second}"].size) == (32, 16 * 3)
 
-    scene.world.node_tree.nodes["Environment Texture"].image = None
+    scene.world.node_tree.nodes["Background"].mute = True         # a world that shows nothing: no World term
     assert sync_operator() == {'FINISHED'}
     assert world_mod.WORLD_GROUP not in bpy.data.node_groups
     assert not world_groups() and not env_images()
@@ -512,3 +545,38 @@ def test_world_occlusion_reads_cycles_ambient_occlusion(bpy_module, world_mod, s
     boxed_occluded, boxed_plain = render(occluded), render(Features("turquin", "cod"))
     np.testing.assert_allclose(boxed_plain, open_plain, rtol=1e-6)      # the unoccluded material ignores the box
     assert boxed_occluded.max() <= 1e-6
+
+
+def test_render_world_array_has_the_environment_texture_layout(bpy_module, world_mod):
+    """Issue 33: a world of nodes is baked from Cycles' equirectangular panoramic render (``render_world_array``),
+    which must lay the world out as an Environment Texture is read (core/environment/equirect.py: row 0 at the
+    zenith, u = 0.5 - atan2(y, x) / 2 pi).  A world showing its Generated direction (x 0.5 + 0.5) at Strength 3,
+    rendered with that Background at Strength 1: each pixel within 3e-3 of the mean of the directions over its area
+    in the mean (measured 8e-4 at 256 x 128, 4 samples), whatever the strength; the scene, camera and world copy it
+    made are removed."""
+    bpy = bpy_module
+    from rt_lookdev.addon import compat
+    from rt_lookdev.core.environment import equirect
+
+    world = compat.new_world("directions")
+    nt = world.node_tree
+    bg = nt.nodes["Background"]
+    bg.inputs["Strength"].default_value = 3.0
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    scale = nt.nodes.new("ShaderNodeVectorMath")
+    scale.operation = "MULTIPLY_ADD"
+    scale.inputs[1].default_value = scale.inputs[2].default_value = (0.5, 0.5, 0.5)
+    nt.links.new(coords.outputs["Generated"], scale.inputs[0])
+    nt.links.new(scale.outputs[0], bg.inputs["Color"])
+    def blocks():           # Blender's own "Render Result" image appears with a session's first render
+        return {kind: set(getattr(bpy.data, kind).keys()) - {"Render Result"}
+                for kind in ("scenes", "worlds", "cameras", "objects", "images")}
+
+    before = blocks()
+    image = world_mod.render_world_array(world, "Background", width=128, samples=4)
+    assert blocks() == before
+    assert image.shape == (64, 128, 3) and image.dtype == np.float32
+    fine = equirect.texel_directions(64 * 4, 128 * 4).reshape(64, 4, 128, 4, 3).mean(axis=(1, 3))
+    error = np.abs(image - (fine * 0.5 + 0.5)).max(axis=-1)
+    assert error.mean() <= 3e-3, error.mean()
+    assert bg.inputs["Strength"].default_value == 3.0            # the original world untouched

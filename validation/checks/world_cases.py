@@ -46,6 +46,7 @@ from ...core.materials.rt_lit_interface import Features
 from ..harness import closures, scene_render
 from . import suite_cases
 from . import suite_scene
+from .node_worlds import NODE_WORLDS
 from .suite_cases import Variant
 from . import suite_cases as suite
 from ...core.conventions import ALPHA_MIN
@@ -140,8 +141,11 @@ class WorldSpec:
     rotation: tuple = (0.0, 0.0, 0.0)
     strength: float = 1.0
     hdri: str = ""                  # studio HDRI name ("" for a synthetic image)
+    kind: str = "image"             # "image" (the file), or a world of nodes: NODE_WORLDS
 
     def describe(self):
+        if self.kind != "image":
+            return NODE_WORLDS[self.kind][1] + (f", strength {self.strength:g}" if self.strength != 1.0 else "")
         s = f"{self.hdri or Path(self.path).name}"
         if any(self.rotation):
             s += " rotated (" + ", ".join(f"{math.degrees(a):.0f}" for a in self.rotation) + ") deg"
@@ -242,11 +246,18 @@ def write_constant_equirect(path, value=1.0, width=64, height=32):
 
 def setup_world(scene, spec):
     """scene.world = Generated -> Mapping (Point, spec.rotation) -> Environment Texture (spec.path,
-    Linear) -> Background (spec.strength) -> World Output."""
+    Linear) -> Background (spec.strength) -> World Output; a world of nodes (``NODE_WORLDS``) for
+    ``spec.kind`` other than "image"."""
     from ...addon import compat
     import bpy
 
     world = compat.new_world(f"RTL_val_world_{spec.name}")
+    if spec.kind != "image":
+        background = world.node_tree.nodes["Background"]
+        background.inputs["Strength"].default_value = float(spec.strength)
+        NODE_WORLDS[spec.kind][0](world.node_tree, background)
+        scene.world = world
+        return world
     nt = world.node_tree
     nt.nodes.clear()
     coords = nt.nodes.new("ShaderNodeTexCoord")
@@ -457,15 +468,17 @@ def cod_reference_image(quad, n, v, roughness, chunk=64, wrap=None):
 
 def sync_world(scene, cache_dir, lut_dir=None):
     """Bake (cached in ``cache_dir``) and sync the scene's world for RT Lit (``addon.world``): returns
-    (WorldEnvironment, world_parameters(scene), EnvironmentBake, the image array Cycles renders
-    (``world_image_array``: scene linear, top row first))."""
+    (WorldEnvironment, world_parameters(scene), EnvironmentBake, the image array Cycles renders at the
+    Background's strength 1 (``world_array``: the image's pixels, a constant, or Cycles' render of the world;
+    scene linear, top row first))."""
     from ...addon import materials
     from ...addon import world_sync as addon_world
 
     setup = addon_world.world_setup(scene.world)
     if not setup.usable:
         raise RuntimeError(f"the validation world is not usable by RT Lit: {setup.reason}")
-    bake = addon_world.bake_world(scene, cache_dir)
+    job = addon_world.bake_job(scene, cache_dir)
+    bake = job()
     record = addon_world.sync_world(scene, cache_dir, bake=bake)
     if record is None:
         raise RuntimeError("sync_world built no 'RTL World' group")
@@ -473,7 +486,18 @@ def sync_world(scene, cache_dir, lut_dir=None):
     found = addon_world.world_environment()
     if found is None:
         raise RuntimeError("no 'RTL World' group with a bake record after sync_world")
-    return found[0], addon_world.world_parameters(scene), bake, addon_world.world_image_array(setup.image)
+    image = job.array
+    if image.shape[0] < 2:                                # a constant world: one texel, the studies want a grid
+        image = np.broadcast_to(image, (512, 1024, 3)).copy()
+    return found[0], addon_world.world_parameters(scene), bake, image
+
+
+def world_source():
+    """Where the synced World term's image came from ("image", "constant", "render": ``WorldSetup.source``)."""
+    from ...addon import world_sync as addon_world
+
+    found = addon_world.world_environment()
+    return None if found is None else found[1].get("source")
 
 
 def measure_bake(scene, cache_dir):

@@ -246,7 +246,8 @@ def _world_record(spec, ws, nr, entries, studies, bake_times, timing, gate_cod, 
             "image": list(ws.nb.resolution), "truth_image": list(ws.tb.resolution) if ws.tb else None,
             "ab": nr.ab, "ab_ok": bool(nr.ab_ok), "variants": entries, "cod": cod, "cod_ok": cod_ok,
             "cod_wrapped": cod_wrapped,
-            "ggx_harness": ggx, "gate_cod": gate_cod, "lambert": lam, "bake": bake_times, "timing_s": timing,
+            "ggx_harness": ggx, "gate_cod": gate_cod, "lambert": lam, "bake": bake_times, "source": vw.world_source(),
+            "timing_s": timing,
             "world_parameters": {k: (list(v) if isinstance(v, (tuple, list, np.ndarray)) else v)
                                  for k, v in ws.params.items()},
             "png": {k: f"{spec.name}/{v}" for k, v in png.items()}}

@@ -46,6 +46,8 @@ Usage:
     blender --background --python scripts/validate_world.py -- [same options]   (needs OpenEXR importable)
     python scripts/validate_world.py --rough-diffuse only   (the rough diffuse and CoD vs Cycles' rough Diffuse
                                                              BSDF, docs/rough_diffuse.md; "add": beside the rest)
+    python scripts/validate_world.py --node-world plain --node-world sky   (worlds of nodes, issue 33: a plain
+        colour baked as a constant, Sky Texture / Mix worlds baked from Cycles' render; alone: only these)
 Full run: 7-9 minutes on 2 cores (521 s measured with other jobs on the machine; about 6 min with
 --samples 512); --quick (one rotated HDRI, few spheres, 256 spp): about 22 s.
 
@@ -87,6 +89,9 @@ def parse_args(argv):
     p.add_argument("--quick", action="store_true",
                    help=f"CI subset: {QUICK[0]} rotated and scaled, few spheres, fewer samples, small furnace")
     p.add_argument("--hdri", action="append", default=None, help="studio HDRI name or EXR path (repeatable)")
+    p.add_argument("--node-world", action="append", default=None, choices=sorted(vw.NODE_WORLDS),
+                   help="a world of nodes that RT Lit bakes as a constant or from Cycles' render of it (repeatable; "
+                        "alone: only these worlds)")
     p.add_argument("--no-rotated", dest="rotated", action="store_false",
                    help=f"skip the rotated world ({ROTATED[0]}, Euler {ROTATED[1]}, strength {ROTATED[2]})")
     p.add_argument("--seed", type=int, default=0, help="seed of the CoD pixel subsets")
@@ -136,6 +141,13 @@ def _fill_defaults(args):
 
 
 def worlds_of(args):
+    nodes = [vw.WorldSpec(kind, "", kind=kind) for kind in (args.node_world or ())]
+    if nodes and not args.hdri:
+        return nodes
+    return _image_worlds(args) + nodes
+
+
+def _image_worlds(args):
     if args.quick and not args.hdri:
         name, rot, s = QUICK
         return [vw.WorldSpec(f"{name}_rotated", str(equirect.resolve_hdri(name)), rot, s, hdri=name)]
@@ -186,7 +198,8 @@ def _run_worlds(args, out_dir, rng, tables, log):
             keep = [v for v in variants if v.technique == "lambert"] if args.rough_diffuse == "only" else variants
             variants = keep + vw.rough_diffuse_variants()
         r, p = run_world(spec, variants, args, out_dir, rng, tables, log,
-                         bake_timing=args.bake_timing and not (rotated and not args.quick))
+                         bake_timing=args.bake_timing and spec.kind == "image" and not (rotated and not args.quick),
+                         gate_cod=spec.kind != "plain")      # a constant world: every lobe direction is exact
         worlds.append(r)
         parts += p
     return worlds, parts
