@@ -386,7 +386,8 @@ class RTL_OT_sync_world(ModalTask, bpy.types.Operator):
             if record is None:
                 self.report({'WARNING'}, f"RT Lit World term off: {setup.reason}; {rebuilt}")
             else:
-                self.report({'INFO'}, f"RT Lit World: '{record['image']}' {world.bake_summary(bake)}; {rebuilt}")
+                shown = f"'{record['image']}'" if record.get("source") == "image" else record["image"]
+                self.report({'INFO'}, f"RT Lit World: {shown} {world.bake_summary(bake)}; {rebuilt}")
             return {'FINISHED'}
 
         return self.start_task(context, work, finish)

@@ -580,3 +580,19 @@ def test_render_world_array_has_the_environment_texture_layout(bpy_module, world
     error = np.abs(image - (fine * 0.5 + 0.5)).max(axis=-1)
     assert error.mean() <= 3e-3, error.mean()
     assert bg.inputs["Strength"].default_value == 3.0            # the original world untouched
+
+
+def test_constant_world_values_are_cleaned(bpy_module, world_mod):
+    """A plain colour with a NaN, an infinite or a negative channel (a driver, a typo) bakes as Cycles shows it: 0
+    there (Cycles shows negative radiance as 0), the rest as it is; one texel, finite."""
+    from rt_lookdev.addon import compat
+
+    world = compat.new_world("odd")
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (float("nan"), -0.5, 0.25, 1.0)
+    setup = world_mod.world_setup(world)
+    assert setup.source == "constant"
+    array = world_mod.world_array(setup)
+    assert array.shape == (1, 1, 3) and array.dtype == np.float32
+    np.testing.assert_array_equal(array[0, 0], [0.0, 0.0, 0.25])
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (float("inf"), 1.0, 1.0, 1.0)
+    assert np.isfinite(world_mod.world_array(world_mod.world_setup(world))).all()
