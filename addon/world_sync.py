@@ -37,6 +37,7 @@ Measured with bpy 5.0.1 (small Cycles renders; tests/blender/test_world_setup.py
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import re
@@ -72,8 +73,9 @@ _IMAGE_SOURCES = ("FILE", "GENERATED")
 # --- the world's setup -------------------------------------------------------------------------------
 
 #: The panoramic render of a world that is neither an image nor a constant (``render_world_array``): width (the
-#: height is half), samples per pixel over a one-pixel box filter (each pixel the average of the world over its
-#: area, as the bake's area averaging wants), and the bake's largest source width (``PrefilterSettings``).
+#: height is half; the bake's largest source width, ``PrefilterSettings.max_source_width``) and samples per pixel
+#: over a one-pixel box filter (each pixel the average of the world over its area, as the bake's area averaging
+#: wants).
 RENDER_WIDTH = 1024
 RENDER_SAMPLES = 16
 
@@ -327,6 +329,31 @@ def world_array(setup):
 PANORAMA_ROTATION = (0.5 * np.pi, 0.0, -0.5 * np.pi)
 
 
+#: The slot of "Render Result" that world renders go to (``render_world_array``): the user's renders stay in theirs.
+RENDER_SLOT = "RT Lookdev world"
+
+
+@contextlib.contextmanager
+def _spare_render_slot():
+    """Render into a slot of its own (made once, then reused; Blender's API adds slots but cannot remove them), so
+    that the user's last render in "Render Result" is not overwritten; the active slot is restored afterwards."""
+    result = bpy.data.images.get("Render Result")
+    slots = getattr(result, "render_slots", None) if result is not None else None
+    if not slots:
+        yield
+        return
+    active = slots.active_index
+    names = [slot.name for slot in slots]                # the collection has no lookup by name
+    if RENDER_SLOT not in names:
+        slots.new(name=RENDER_SLOT)
+        names.append(RENDER_SLOT)
+    slots.active_index = names.index(RENDER_SLOT)
+    try:
+        yield
+    finally:
+        slots.active_index = active
+
+
 def render_world_array(world, unit_background=None, width=RENDER_WIDTH, samples=RENDER_SAMPLES):
     """Cycles' equirectangular render of ``world`` (``width`` x ``width / 2``, ``samples`` per pixel over a
     one-pixel box, no bounces: each pixel the world's mean over its area) as ``world_image_array`` returns
@@ -355,7 +382,7 @@ def render_world_array(world, unit_background=None, width=RENDER_WIDTH, samples=
         cycles.max_bounces = 0
         cycles.pixel_filter_type, cycles.filter_width = "BOX", 1.0
         compat.set_exr_output(render.image_settings)
-        with tempfile.TemporaryDirectory(prefix="rtl-world-") as folder:
+        with tempfile.TemporaryDirectory(prefix="rtl-world-") as folder, _spare_render_slot():
             render.filepath = str(Path(folder) / "world.exr")
             bpy.ops.render.render(write_still=True, scene=scene.name)
             image = bpy.data.images.load(render.filepath)

@@ -553,7 +553,7 @@ def test_render_world_array_has_the_environment_texture_layout(bpy_module, world
     zenith, u = 0.5 - atan2(y, x) / 2 pi).  A world showing its Generated direction (x 0.5 + 0.5) at Strength 3,
     rendered with that Background at Strength 1: each pixel within 3e-3 of the mean of the directions over its area
     in the mean (measured 8e-4 at 256 x 128, 4 samples), whatever the strength; the scene, camera and world copy it
-    made are removed."""
+    made are removed, and the user's render in "Render Result" is kept (its own slot)."""
     bpy = bpy_module
     from rt_lookdev.addon import compat
     from rt_lookdev.core.environment import equirect
@@ -580,6 +580,14 @@ def test_render_world_array_has_the_environment_texture_layout(bpy_module, world
     error = np.abs(image - (fine * 0.5 + 0.5)).max(axis=-1)
     assert error.mean() <= 3e-3, error.mean()
     assert bg.inputs["Strength"].default_value == 3.0            # the original world untouched
+    # the user's last render stays in its "Render Result" slot: world renders go to a slot of their own, reused
+    slots = bpy.data.images["Render Result"].render_slots
+    slots.active_index = 0
+    world_mod.render_world_array(world, "Background", width=16, samples=1)
+    count = len(slots)
+    world_mod.render_world_array(world, "Background", width=16, samples=1)
+    assert slots.active_index == 0 and len(slots) == count
+    assert [slot.name for slot in slots].count(world_mod.RENDER_SLOT) == 1
 
 
 def test_constant_world_values_are_cleaned(bpy_module, world_mod):
