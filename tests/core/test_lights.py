@@ -823,13 +823,14 @@ def test_lambert_under_a_disk_with_spread_is_exact_along_its_rays(energy_tables)
     assert max(ir_errors) <= 1e-4
 
 
-def _foot_polar_truth(normal, height, foot, half_u, half_v, reach, panels=4096, radial=48):
+def _foot_polar_truth(normal, height, foot, half_u, half_v, reach, panels=1024, radial=24):
     """The clamped cosine over pi times Cycles' spread weight (its kernel's formula, of the distance rho from the
     cone's foot: 1 - rho / R) over an ellipse light of semi-axes ``half_u`` x ``half_v`` along X and Y in the plane
     z = ``height`` above the origin, emitting down, in polar coordinates about the foot ((0, 0, height); ``foot`` the
     foot's offset from the ellipse's centre): Gauss-Legendre panels in the angle, and along each ray's chord (the
     ellipse's quadratic, cut at R and split where it crosses the receiver's horizon) Gauss-Legendre in rho: dense
-    where the light is thin and close, where a grid over the light misses its near part."""
+    where the light is thin and close, where a grid over the light misses its near part.  The defaults agree with
+    4096 panels x 48 points to 1.8e-5 relative on the thin-ellipse cases below."""
     x, w = np.polynomial.legendre.leggauss(8)
     edges = np.linspace(0.0, 2 * np.pi, panels + 1)
     half = (edges[1] - edges[0]) / 2
@@ -872,12 +873,20 @@ def test_lambert_under_a_thin_ellipse_with_spread_seen_close(energy_tables):
     float32 within 1e-4 of float64."""
     body = lights.light_spread.LAMBERT_DISK.function
 
-    def rule(dtype, normal, height, foot, half_u, half_v, reach):
-        kw = {"Position": np.zeros(3), "Normal": normal, "Foot": np.array([0.0, 0.0, height]),
-              "Disk Center": np.array([-foot[0], -foot[1], height]), "Disk Axis U": np.array([half_u, 0.0, 0.0]),
-              "Disk Axis V": np.array([0.0, half_v, 0.0]), "Cone Radius": reach, "Cone Scale": 1.0, "Two Sided": 0.0}
-        (value,) = evaluate((body.outputs["Form Factor"],), {k: np.asarray(v, dtype) for k, v in kw.items()}, dtype)
-        return float(value)
+    def rule(dtype, cases):
+        """The rule at every case at once (the IR evaluates arrays)."""
+        def rows(f):
+            return np.array([f(*case) for case in cases], np.float64)
+
+        kw = {"Position": rows(lambda *c: np.zeros(3)), "Normal": rows(lambda n, *c: n),
+              "Foot": rows(lambda n, t, *c: [0.0, 0.0, t]),
+              "Disk Center": rows(lambda n, t, g, *c: [-g[0], -g[1], t]),
+              "Disk Axis U": rows(lambda n, t, g, a, *c: [a, 0.0, 0.0]),
+              "Disk Axis V": rows(lambda n, t, g, a, b, r: [0.0, b, 0.0]),
+              "Cone Radius": rows(lambda *c: c[-1]), "Cone Scale": rows(lambda *c: 1.0),
+              "Two Sided": rows(lambda *c: 0.0)}
+        (value,) = evaluate((body.outputs["Form Factor"],), {k: v.astype(dtype) for k, v in kw.items()}, dtype)
+        return np.asarray(value, np.float64)
 
     rng = np.random.default_rng(27)
     seen = np.radians(46.4)                                           # the robustness case's receiver, N.axis 0.689
@@ -892,15 +901,12 @@ def test_lambert_under_a_thin_ellipse_with_spread_seen_close(energy_tables):
         case = (normal / np.linalg.norm(normal), height, foot, 1.0, half_v, reach)
         if _foot_polar_truth(*case) > 1e-3 * reach * reach / (reach * reach + height * height):
             cases.append(case)                                        # not a sliver of the cone's reach
-    errors, f32 = [], []
-    for case in cases:
-        truth = _foot_polar_truth(*case)
-        value = rule(np.float64, *case)
-        errors.append(abs(value / truth - 1))
-        f32.append(abs(rule(np.float32, *case) / value - 1))
+    truth = np.array([_foot_polar_truth(*case) for case in cases])
+    value = rule(np.float64, cases)
+    errors = np.abs(value / truth - 1)
+    f32 = np.abs(rule(np.float32, cases) / value - 1)
     assert errors[0] <= 5e-3, (errors[0], "the robustness case")
-    errors = np.array(errors)
     print(f"thin ellipses: median {np.median(errors):.3%}, p90 {np.percentile(errors, 90):.3%}, "
-          f"max {errors.max():.3%}; float32 max {max(f32):.1e}")
+          f"max {errors.max():.3%}; float32 max {f32.max():.1e}")
     assert np.median(errors) <= 5e-3 and np.percentile(errors, 90) <= 3e-2
-    assert max(f32) <= 1e-4
+    assert f32.max() <= 1e-4
