@@ -25,12 +25,13 @@ Measured with bpy 5.0.1 (small Cycles renders; tests/blender/test_world_setup.py
 - ``World.use_nodes`` is deprecated in 5.0 and setting it to False is ignored (the world always
   renders its nodes); it is checked only before 5.0.
 - An unlinked Mapping Vector input is the constant (0, 0, 0), not the view direction: the world then
-  shows one texel everywhere, so it is refused.  A muted link counts as no link.
+  shows one texel everywhere, so it is not read as an image (it is rendered, one colour).  A muted link counts
+  as no link.
 - ``Image.pixels`` of a float image are already scene linear (Blender converts on load, whatever
   the colour space), and Cycles renders the same values, with negative values shown as 0 and alpha
   ignored; those of an 8-bit image are the raw bytes / 255 (Cycles applies the colour space at
   render time): sRGB is decoded here, Non-Color and the working space pass through, other spaces
-  are refused.
+  are rendered by Cycles instead.
 - Drivers inside a node group are evaluated only while something in the view layer uses the group
   (an RT Lit material on an object); then ``view_layer.update()`` writes the driven values back
   to the original nodes.
@@ -319,7 +320,7 @@ def world_array(setup):
         return np.maximum(colour, 0.0).reshape(1, 1, 3)
     if setup.source == "render":
         unit = setup.live_strength is not None
-        return render_world_array(setup.world, setup.background.name if unit else None)
+        return render_world_array(setup.world, setup.background.name if unit else None, RENDER_WIDTH, RENDER_SAMPLES)
     raise ValueError(f"the world is not usable: {setup.reason}")
 
 

@@ -105,10 +105,15 @@ def node_worlds(tmp_path_factory, lut_dir, bpy_module):
     Mix-node world (baked from Cycles' panoramic render of it)."""
     from rt_lookdev.validation.checks import world_suite as validate_world
 
+    from rt_lookdev.addon import world_sync
+
     out = tmp_path_factory.mktemp("validation_node_worlds")
     argv = ["--quick", "--no-bake-timing", "--skip-furnace", "--node-world", "plain", "--node-world", "mix",
+            "--lambert-image", "256", "--ggx-image", "256",
             "--out", str(out), "--lut-dir", str(lut_dir), "--harness-lambert-median", str(HARNESS_MEDIAN)]
-    return validate_world.run(validate_world.parse_args(argv), log=lambda s: None)
+    with pytest.MonkeyPatch.context() as patch:      # the smooth Mix world rendered at 256 x 128: its bake in 2 s
+        patch.setattr(world_sync, "RENDER_WIDTH", 256)
+        return validate_world.run(validate_world.parse_args(argv), log=lambda s: None)
 
 
 @pytest.mark.development_release_only
