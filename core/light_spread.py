@@ -655,8 +655,8 @@ def spread_disk(position, centre, axis_u, axis_v, spread):
 # (rays even in the light's own angle, as first written: all but a few along a thin ellipse's length, 6x too bright
 # 0.6 mm under a 0.24 mm one).
 
-#: Rays of the Lambert rule: Gauss-Legendre nodes and weights on [-1, 1] (the foot outside the disk's bounding circle)
-#: and the midpoint rule's (inside it), per ray.
+#: Rays of the Lambert rule: Gauss-Legendre nodes and weights on [-1, 1] (the foot outside the light's ellipse) and
+#: the midpoint rule's (inside it), per ray.
 LAMBERT_RAYS = 16
 LAMBERT_GAUSS = tuple(zip(*(tuple(float(x) for x in a) for a in np.polynomial.legendre.leggauss(LAMBERT_RAYS))))
 LAMBERT_MIDPOINTS = tuple(((2 * i + 1) / LAMBERT_RAYS - 1.0, 2.0 / LAMBERT_RAYS) for i in range(LAMBERT_RAYS))
